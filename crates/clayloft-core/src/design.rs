@@ -1,0 +1,291 @@
+//! The design file (SPEC §6): a TOML document, version 1, that says everything needed to make a
+//! vessel. Every field except `version` and the two contours has a default (the paper's clay
+//! printer); unknown fields are errors so that typos never pass silently.
+//!
+//! This module holds the data types and their defaults only. Reading a file with line-accurate
+//! errors is [`crate::load`]; checking physical ranges is [`crate::validate`].
+
+use serde::{Deserialize, Serialize};
+
+/// The only design-file version this build reads and writes.
+pub const DESIGN_VERSION: u32 = 1;
+
+/// A whole design: printer, shape, control lines, texture and constraint policy.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Design {
+    pub version: u32,
+    #[serde(default = "default_name")]
+    pub name: String,
+    #[serde(default)]
+    pub printer: Printer,
+    pub shape: Shape,
+    #[serde(default)]
+    pub control: Control,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<Texture>,
+    #[serde(default)]
+    pub constraints: Constraints,
+}
+
+fn default_name() -> String {
+    "untitled vessel".to_string()
+}
+
+/// How E values are written: per move (M83) or cumulative (M82).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ExtrusionMode {
+    #[default]
+    Relative,
+    Absolute,
+}
+
+/// The printer and the print settings. Defaults: the paper's clay printer (Cerambot Plus class).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Printer {
+    /// Bed size along x, mm.
+    pub bed_x: f64,
+    /// Bed size along y, mm.
+    pub bed_y: f64,
+    /// Maximum build height, mm.
+    pub max_z: f64,
+    pub nozzle_diameter: f64,
+    /// Width of the extruded bead, mm; the printed wall is this thick.
+    pub line_width: f64,
+    /// Nominal layer height, mm; must lie in `min_layer_height ..= max_layer_height`.
+    pub layer_height: f64,
+    pub min_layer_height: f64,
+    pub max_layer_height: f64,
+    /// Length of the nozzle tube below its holder, mm (collision limit per layer).
+    pub nozzle_length: f64,
+    /// Largest lean of the wall from vertical that prints without support, degrees.
+    pub max_overhang_deg: f64,
+    /// mm/s.
+    pub print_speed: f64,
+    /// mm/s, approach and exit only.
+    pub travel_speed: f64,
+    /// Calibration constant of the clay extruder (ram or auger equivalent), mm.
+    pub feed_diameter: f64,
+    pub flow_multiplier: f64,
+    pub extrusion: ExtrusionMode,
+    /// Minimum time per revolution, s (0 = off): small layers are slowed so the clay can stiffen.
+    pub min_layer_time: f64,
+    /// Length of wall path at the start of the spiral over which flow ramps up from 25 %, mm.
+    pub flow_ramp_start: f64,
+    /// Length of path at the end over which flow ramps down to 25 %, mm.
+    pub flow_ramp_end: f64,
+}
+
+impl Default for Printer {
+    fn default() -> Self {
+        Printer {
+            bed_x: 180.0,
+            bed_y: 190.0,
+            max_z: 200.0,
+            nozzle_diameter: 3.0,
+            line_width: 3.0,
+            layer_height: 1.0,
+            min_layer_height: 0.25,
+            max_layer_height: 1.0,
+            nozzle_length: 30.0,
+            max_overhang_deg: 45.0,
+            print_speed: 20.0,
+            travel_speed: 50.0,
+            feed_diameter: 3.0,
+            flow_multiplier: 1.0,
+            extrusion: ExtrusionMode::Relative,
+            min_layer_time: 0.0,
+            flow_ramp_start: 0.0,
+            flow_ramp_end: 0.0,
+        }
+    }
+}
+
+/// The large-scale shape: height, sampling, placement, base and the two contours.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shape {
+    #[serde(default = "default_height")]
+    pub height: f64,
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Centre of the design on the bed, mm; `None` = bed centre.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center: Option<[f64; 2]>,
+    #[serde(default = "default_base_layers")]
+    pub base_layers: usize,
+    /// Contour at z = 0.
+    pub lower: ContourSpec,
+    /// Contour at z = height.
+    pub upper: ContourSpec,
+}
+
+fn default_height() -> f64 {
+    120.0
+}
+fn default_samples() -> usize {
+    200
+}
+fn default_base_layers() -> usize {
+    2
+}
+
+/// A closed contour, by kind. Dimensions in mm, centred on the origin before alignment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub enum ContourSpec {
+    Circle {
+        radius: f64,
+    },
+    Ellipse {
+        rx: f64,
+        ry: f64,
+    },
+    /// Regular polygon of `sides` with circumradius `radius`, corners rounded by `corner_radius`.
+    Polygon {
+        sides: usize,
+        radius: f64,
+        #[serde(default)]
+        corner_radius: f64,
+    },
+    Star {
+        points: usize,
+        outer_radius: f64,
+        inner_radius: f64,
+    },
+    /// Rose / petal curve `r(θ) = radius + amplitude·cos(petals·θ)`.
+    Rose {
+        radius: f64,
+        amplitude: f64,
+        petals: usize,
+    },
+    /// Closed centripetal Catmull–Rom spline through the points.
+    Spline {
+        points: Vec<[f64; 2]>,
+    },
+    /// Outline traced from a picture (not supported yet).
+    Image {
+        path: String,
+        size: f64,
+    },
+    /// Outline read from an SVG path (not supported yet).
+    Svg {
+        path: String,
+        size: f64,
+    },
+}
+
+/// Control lines: large-scale shaping of the loft.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Control {
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertical: Vec<VerticalLine>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub horizontal: Vec<HorizontalLine>,
+}
+
+/// Outward offset along the height: `points` are `[t, offset_mm]` with `t` the height fraction.
+/// With `angle` (and `width`) it acts only around that angle, with a smooth fall-off.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VerticalLine {
+    pub points: Vec<[f64; 2]>,
+    /// Centre angle of a local line, degrees counter-clockwise from +x.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
+    /// Full width of a local line's influence, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width: Option<f64>,
+}
+
+/// Z offset around a section: `points` are `[angle_deg, dz_mm]`, periodic in angle; full effect
+/// at height fraction `at`, fading to zero over `reach`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HorizontalLine {
+    pub at: f64,
+    pub reach: f64,
+    pub points: Vec<[f64; 2]>,
+}
+
+/// How the x and y waves of a texture combine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Combine {
+    #[default]
+    Product,
+    Sum,
+}
+
+/// Periodic waveform.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WaveKind {
+    Sine,
+    Triangle,
+    Square,
+}
+
+/// One periodic wave: amplitude (mm) and period (samples for x, layers for y).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Wave {
+    pub wave: WaveKind,
+    pub period: f64,
+    pub amplitude: f64,
+}
+
+/// Small-scale texture: periodic waves embedded along the surface normal (SPEC §3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Texture {
+    #[serde(default)]
+    pub combine: Combine,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x: Option<Wave>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y: Option<Wave>,
+    /// Shift of the x wave per layer, samples (twisted textures).
+    #[serde(default)]
+    pub phase_drift: f64,
+    /// Height fraction where the texture starts.
+    #[serde(default)]
+    pub start: f64,
+    /// Height fraction where the texture ends.
+    #[serde(default = "one")]
+    pub end: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Whether manufacturing limits are enforced (corrected) or only reported.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Constraints {
+    pub enforce: bool,
+}
+
+impl Default for Constraints {
+    fn default() -> Self {
+        Constraints { enforce: true }
+    }
+}
+
+impl Design {
+    /// Centre of the design on the bed: `shape.center`, or the bed centre.
+    pub fn center(&self) -> [f64; 2] {
+        self.shape
+            .center
+            .unwrap_or([self.printer.bed_x / 2.0, self.printer.bed_y / 2.0])
+    }
+
+    /// The design as TOML text, in the file format it was read from.
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+}

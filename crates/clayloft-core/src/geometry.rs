@@ -1,0 +1,239 @@
+//! Plain 2D polyline geometry shared by the pipeline stages: area, orientation, arc length,
+//! resampling and self-intersection tests on closed polylines.
+//!
+//! A closed polyline is a `&[DVec2]` whose last point connects back to the first; the first point
+//! is *not* repeated at the end.
+
+use glam::DVec2;
+
+/// Two points closer than this (mm) are the same point. Contours are tens of millimetres across,
+/// so a micrometre is far below anything a printer resolves and far above rounding noise.
+pub const POINT_EPS: f64 = 1e-6;
+
+/// Signed area of a closed polyline by the shoelace formula, `A = ½ Σ (xᵢ yᵢ₊₁ − xᵢ₊₁ yᵢ)`.
+/// Positive for counter-clockwise order.
+pub fn signed_area(points: &[DVec2]) -> f64 {
+    let n = points.len();
+    (0..n)
+        .map(|i| points[i].perp_dot(points[(i + 1) % n]))
+        .sum::<f64>()
+        * 0.5
+}
+
+/// Total length of a closed polyline (including the closing segment).
+pub fn closed_length(points: &[DVec2]) -> f64 {
+    let n = points.len();
+    (0..n).map(|i| points[i].distance(points[(i + 1) % n])).sum()
+}
+
+/// Cumulative arc length at each vertex of a closed polyline: `s[0] = 0`, `s[i] = Σ_{j<i} |p_{j+1} − p_j|`.
+/// The returned vector has `n + 1` entries; the last one is the closed length.
+pub fn cumulative_length(points: &[DVec2]) -> Vec<f64> {
+    let n = points.len();
+    let mut s = Vec::with_capacity(n + 1);
+    let mut acc = 0.0;
+    s.push(0.0);
+    for i in 0..n {
+        acc += points[i].distance(points[(i + 1) % n]);
+        s.push(acc);
+    }
+    s
+}
+
+/// Resamples a closed polyline at `count` points equally spaced by arc length, starting at its
+/// first vertex and following its order. Linear interpolation along the polyline's segments.
+pub fn resample_closed(points: &[DVec2], count: usize) -> Vec<DVec2> {
+    let n = points.len();
+    let s = cumulative_length(points);
+    let total = s[n];
+    let step = total / count as f64;
+    let mut out = Vec::with_capacity(count);
+    let mut seg = 0;
+    for k in 0..count {
+        let target = k as f64 * step;
+        while seg + 1 < n && s[seg + 1] <= target {
+            seg += 1;
+        }
+        let len = s[seg + 1] - s[seg];
+        let f = if len > 0.0 { (target - s[seg]) / len } else { 0.0 };
+        out.push(points[seg].lerp(points[(seg + 1) % n], f));
+    }
+    out
+}
+
+/// Removes consecutive duplicates (closer than [`POINT_EPS`]), including a last point equal to the
+/// first.
+pub fn dedup_closed(points: &[DVec2]) -> Vec<DVec2> {
+    let mut out: Vec<DVec2> = Vec::with_capacity(points.len());
+    for &p in points {
+        if out.last().is_none_or(|q: &DVec2| q.distance(p) > POINT_EPS) {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && out[0].distance(out[out.len() - 1]) <= POINT_EPS {
+        out.pop();
+    }
+    out
+}
+
+/// Whether segments `a0–a1` and `b0–b1` cross or touch (proper or collinear overlap).
+pub fn segments_intersect(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> bool {
+    let d1 = (a1 - a0).perp_dot(b0 - a0);
+    let d2 = (a1 - a0).perp_dot(b1 - a0);
+    let d3 = (b1 - b0).perp_dot(a0 - b0);
+    let d4 = (b1 - b0).perp_dot(a1 - b0);
+    let eps = 1e-12;
+    if ((d1 > eps && d2 < -eps) || (d1 < -eps && d2 > eps))
+        && ((d3 > eps && d4 < -eps) || (d3 < -eps && d4 > eps))
+    {
+        return true;
+    }
+    let on = |p: DVec2, q0: DVec2, q1: DVec2, d: f64| {
+        d.abs() <= eps
+            && p.x >= q0.x.min(q1.x) - eps
+            && p.x <= q0.x.max(q1.x) + eps
+            && p.y >= q0.y.min(q1.y) - eps
+            && p.y <= q0.y.max(q1.y) + eps
+    };
+    on(b0, a0, a1, d1) || on(b1, a0, a1, d2) || on(a0, b0, b1, d3) || on(a1, b0, b1, d4)
+}
+
+/// Finds a pair of non-adjacent segments of a closed polyline that intersect, if any.
+///
+/// Sweep over x: segments sorted by their left end, an active list pruned by right end. For the
+/// contours of vessels only a handful of segments span any x, so this is close to `O(n log n)`.
+pub fn find_self_intersection(points: &[DVec2]) -> Option<(usize, usize)> {
+    let n = points.len();
+    if n < 4 {
+        return None;
+    }
+    let seg = |i: usize| (points[i], points[(i + 1) % n]);
+    let mut order: Vec<usize> = (0..n).collect();
+    let min_x = |i: usize| {
+        let (a, b) = seg(i);
+        a.x.min(b.x)
+    };
+    order.sort_by(|&a, &b| min_x(a).total_cmp(&min_x(b)));
+    let mut active: Vec<usize> = Vec::new();
+    for &i in &order {
+        let (a0, a1) = seg(i);
+        let left = a0.x.min(a1.x);
+        active.retain(|&j| {
+            let (b0, b1) = seg(j);
+            b0.x.max(b1.x) >= left
+        });
+        for &j in &active {
+            let adjacent = (i + 1) % n == j || (j + 1) % n == i;
+            if adjacent {
+                continue;
+            }
+            let (b0, b1) = seg(j);
+            let (ylo, yhi) = (a0.y.min(a1.y), a0.y.max(a1.y));
+            if b0.y.max(b1.y) < ylo || b0.y.min(b1.y) > yhi {
+                continue;
+            }
+            if segments_intersect(a0, a1, b0, b1) {
+                return Some((i.min(j), i.max(j)));
+            }
+        }
+        active.push(i);
+    }
+    None
+}
+
+/// Outward unit normal in XY at each vertex of a counter-clockwise closed polyline, from the
+/// central difference `pᵢ₊₁ − pᵢ₋₁` rotated by −90°.
+pub fn outward_normals(points: &[DVec2]) -> Vec<DVec2> {
+    let n = points.len();
+    (0..n)
+        .map(|i| {
+            let d = points[(i + 1) % n] - points[(i + n - 1) % n];
+            DVec2::new(d.y, -d.x).normalize_or_zero()
+        })
+        .collect()
+}
+
+/// Distance from `p` to segment `a–b`, and the parameter `f ∈ [0, 1]` of the closest point.
+pub fn point_segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let f = if len2 > 0.0 {
+        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p.distance(a + ab * f), f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    fn circle(r: f64, n: usize) -> Vec<DVec2> {
+        (0..n)
+            .map(|i| DVec2::from_angle(TAU * i as f64 / n as f64) * r)
+            .collect()
+    }
+
+    #[test]
+    fn unit_square_area_and_orientation() {
+        let sq = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(0.0, 1.0),
+        ];
+        assert!((signed_area(&sq) - 1.0).abs() < 1e-12);
+        let rev: Vec<_> = sq.iter().rev().copied().collect();
+        assert!((signed_area(&rev) + 1.0).abs() < 1e-12);
+        assert!((closed_length(&sq) - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn resampling_is_equally_spaced() {
+        let sq = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(4.0, 0.0),
+            DVec2::new(4.0, 4.0),
+            DVec2::new(0.0, 4.0),
+        ];
+        let r = resample_closed(&sq, 8);
+        assert_eq!(r.len(), 8);
+        assert!(r[1].distance(DVec2::new(2.0, 0.0)) < 1e-12);
+        assert!(r[3].distance(DVec2::new(4.0, 2.0)) < 1e-12);
+        assert!(r[7].distance(DVec2::new(0.0, 2.0)) < 1e-12);
+    }
+
+    #[test]
+    fn circle_has_no_self_intersection_but_figure_eight_has() {
+        assert_eq!(find_self_intersection(&circle(10.0, 500)), None);
+        let eight: Vec<DVec2> = (0..400)
+            .map(|i| {
+                let t = TAU * i as f64 / 400.0;
+                DVec2::new(t.sin(), (2.0 * t).sin() * 0.5)
+            })
+            .collect();
+        assert!(find_self_intersection(&eight).is_some());
+    }
+
+    #[test]
+    fn normals_of_ccw_circle_point_outward() {
+        let c = circle(5.0, 64);
+        for (p, n) in c.iter().zip(outward_normals(&c)) {
+            assert!((n - p.normalize()).length() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn dedup_drops_repeats_and_closing_point() {
+        let pts = [
+            DVec2::ZERO,
+            DVec2::ZERO,
+            DVec2::X,
+            DVec2::ONE,
+            DVec2::ZERO,
+        ];
+        assert_eq!(dedup_closed(&pts).len(), 3);
+    }
+}

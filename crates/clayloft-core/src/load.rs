@@ -1,0 +1,285 @@
+//! Reading a design file: bytes → TOML → [`Design`] → validated, with every problem reported as
+//! one sentence that names the file, the line and the field.
+
+use std::path::{Path, PathBuf};
+
+use crate::design::Design;
+use crate::validate::{FieldError, validate};
+
+/// Largest design file we read, bytes. Designs are a few kilobytes; this keeps a wrong path (a
+/// video, a disk image) from being read into memory.
+const MAX_DESIGN_BYTES: u64 = 16 * 1024 * 1024;
+
+/// A problem reading a design file, ready to show to the user as one line.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum DesignError {
+    #[error("{file}: cannot read the design: {reason}")]
+    Read { file: String, reason: String },
+    #[error("{file}:{line}: {message}")]
+    Syntax { file: String, line: usize, message: String },
+    #[error("{file}{}: {field}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Field {
+        file: String,
+        line: Option<usize>,
+        field: String,
+        message: String,
+    },
+}
+
+/// A parsed and validated design together with its source text, kept so that later problems
+/// (for example a shape that does not fit the bed) can still be reported with a line number.
+#[derive(Debug, Clone)]
+pub struct LoadedDesign {
+    pub design: Design,
+    pub path: PathBuf,
+    source: String,
+}
+
+impl LoadedDesign {
+    /// Turns a field problem found after loading into a located error for this file.
+    pub fn locate(&self, err: FieldError) -> DesignError {
+        located(&self.path, &self.source, err)
+    }
+}
+
+/// Reads, parses and validates a design file.
+pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
+    let file = path.display().to_string();
+    let read_err = |reason: String| DesignError::Read { file: file.clone(), reason };
+    let meta = std::fs::metadata(path).map_err(|e| read_err(io_reason(&e)))?;
+    if meta.is_dir() {
+        return Err(read_err("it is a folder, not a file".into()));
+    }
+    if meta.len() > MAX_DESIGN_BYTES {
+        return Err(read_err(format!(
+            "{} bytes is far too large for a design file",
+            meta.len()
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| read_err(io_reason(&e)))?;
+    let source = String::from_utf8(bytes)
+        .map_err(|_| read_err("it is not a text (UTF-8) file — is it a design?".into()))?;
+    let design = parse_design(&source).map_err(|e| match e {
+        ParseError::Syntax { line, message } => DesignError::Syntax { file: file.clone(), line, message },
+        ParseError::Field(f) => located(path, &source, f),
+    })?;
+    Ok(LoadedDesign { design, path: path.to_path_buf(), source })
+}
+
+/// A problem in design text, before a file name is attached.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParseError {
+    Syntax { line: usize, message: String },
+    Field(FieldError),
+}
+
+/// Parses and validates design text.
+pub fn parse_design(source: &str) -> Result<Design, ParseError> {
+    let design: Design = toml::from_str(source).map_err(|e| {
+        let line = e.span().map(|s| line_of(source, s.start)).unwrap_or(1);
+        ParseError::Syntax { line, message: first_line(e.message()) }
+    })?;
+    validate(&design).map_err(ParseError::Field)?;
+    Ok(design)
+}
+
+fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string(),
+    }
+}
+
+fn first_line(s: &str) -> String {
+    s.lines().next().unwrap_or("").trim().to_string()
+}
+
+/// 1-based line number of byte offset `pos`.
+fn line_of(source: &str, pos: usize) -> usize {
+    source.as_bytes()[..pos.min(source.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+fn located(path: &Path, source: &str, err: FieldError) -> DesignError {
+    DesignError::Field {
+        file: path.display().to_string(),
+        line: field_offset(source, &err.field).map(|o| line_of(source, o)),
+        field: err.field,
+        message: err.message,
+    }
+}
+
+/// Byte offset in `source` of the field at a dotted path like `control.vertical[1].points[2]`.
+/// Falls back to the nearest enclosing table that is written in the file.
+fn field_offset(source: &str, field: &str) -> Option<usize> {
+    let doc = toml_edit::Document::parse(source).ok()?;
+    let mut item = doc.as_item();
+    let mut best = None;
+    for part in field.split('.') {
+        let (key, indices) = match part.find('[') {
+            Some(i) => (&part[..i], &part[i..]),
+            None => (part, ""),
+        };
+        let next = match item {
+            toml_edit::Item::Table(t) => {
+                let (k, v) = t.get_key_value(key)?;
+                best = k.span().map(|s| s.start).or(best);
+                v
+            }
+            toml_edit::Item::Value(toml_edit::Value::InlineTable(t)) => {
+                let (k, v) = t.get_key_value(key)?;
+                best = k.span().map(|s| s.start).or(best);
+                v
+            }
+            _ => return best,
+        };
+        item = next;
+        for idx in indices
+            .split(['[', ']'])
+            .filter(|s| !s.is_empty())
+            .filter_map(|s| s.parse::<usize>().ok())
+        {
+            match item {
+                toml_edit::Item::ArrayOfTables(a) => {
+                    let t = a.get(idx)?;
+                    best = t.span().map(|s| s.start).or(best);
+                    return descend_table(t, field, part, best);
+                }
+                toml_edit::Item::Value(toml_edit::Value::Array(a)) => {
+                    let v = a.get(idx)?;
+                    return v.span().map(|s| s.start).or(best);
+                }
+                _ => return best,
+            }
+        }
+    }
+    best
+}
+
+/// Continues [`field_offset`] inside one table of an array of tables.
+fn descend_table(t: &toml_edit::Table, field: &str, part: &str, best: Option<usize>) -> Option<usize> {
+    let rest = field.split_once(part).map(|(_, r)| r.trim_start_matches('.')).unwrap_or("");
+    if rest.is_empty() {
+        return best;
+    }
+    let (key, idx) = match rest.split_once('[') {
+        Some((k, i)) => (k.split('.').next().unwrap_or(k), i.trim_end_matches(']').parse::<usize>().ok()),
+        None => (rest.split('.').next().unwrap_or(rest), None),
+    };
+    let Some((k, v)) = t.get_key_value(key) else { return best };
+    let here = k.span().map(|s| s.start).or(best);
+    match (v, idx) {
+        (toml_edit::Item::Value(toml_edit::Value::Array(a)), Some(i)) => {
+            a.get(i).and_then(|v| v.span()).map(|s| s.start).or(here)
+        }
+        _ => here,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MINIMAL: &str = "version = 1\n[shape.lower]\ntype = \"circle\"\nradius = 40.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n";
+
+    fn err_of(src: &str) -> ParseError {
+        parse_design(src).expect_err("should fail")
+    }
+
+    #[test]
+    fn minimal_design_takes_every_default() {
+        let d = parse_design(MINIMAL).unwrap();
+        assert_eq!(d.printer, crate::design::Printer::default());
+        assert_eq!(d.shape.height, 120.0);
+        assert_eq!(d.shape.samples, 200);
+        assert_eq!(d.shape.base_layers, 2);
+        assert_eq!(d.center(), [90.0, 95.0]);
+        assert!(d.constraints.enforce);
+        assert_eq!(d.name, "untitled vessel");
+    }
+
+    #[test]
+    fn misspelt_field_is_named_with_its_line() {
+        let src = MINIMAL.replace("[shape.upper]", "[shape]\nheigth = 3\n[shape.upper]");
+        match err_of(&src) {
+            ParseError::Syntax { line, message } => {
+                assert!(message.contains("heigth"), "{message}");
+                assert_eq!(line, 6);
+            }
+            e => panic!("{e:?}"),
+        }
+    }
+
+    #[test]
+    fn negative_height_is_a_field_error_on_its_line() {
+        let src = "version = 1\n[shape]\nheight = -5.0\n[shape.lower]\ntype = \"circle\"\nradius = 40.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n";
+        let e = load_str(src);
+        let msg = e.to_string();
+        assert!(msg.contains(":3: shape.height"), "{msg}");
+        assert!(msg.contains("greater than 0"), "{msg}");
+    }
+
+    #[test]
+    fn nan_and_infinity_are_rejected() {
+        for v in ["nan", "inf", "-inf"] {
+            let src = MINIMAL.replace("radius = 40.0", &format!("radius = {v}"));
+            match err_of(&src) {
+                ParseError::Field(f) => assert_eq!(f.field, "shape.lower.radius"),
+                e => panic!("{e:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn layer_height_outside_printer_range() {
+        let src = format!("{MINIMAL}[printer]\nlayer_height = 1.5\n");
+        let e = load_str(&src).to_string();
+        assert!(e.contains(":9: printer.layer_height"), "{e}");
+        assert!(e.contains("outside the printer's range"), "{e}");
+    }
+
+    #[test]
+    fn samples_bounds() {
+        for s in ["2", "100000000"] {
+            let src = MINIMAL.replace("version = 1\n", &format!("version = 1\n[shape]\nsamples = {s}\n"));
+            match err_of(&src) {
+                ParseError::Field(f) => assert_eq!(f.field, "shape.samples"),
+                e => panic!("{e:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn image_contour_is_not_supported_yet() {
+        let src = MINIMAL.replace("type = \"circle\"\nradius = 40.0", "type = \"image\"\npath = \"leaf.png\"\nsize = 80.0");
+        let e = load_str(&src).to_string();
+        assert!(e.contains("shape.lower.type") && e.contains("not supported yet"), "{e}");
+    }
+
+    #[test]
+    fn array_element_field_is_located() {
+        let src = format!(
+            "{MINIMAL}[[control.vertical]]\npoints = [[0.0, 0.0], [1.0, 1.0]]\n[[control.vertical]]\npoints = [\n  [0.0, 0.0],\n  [1.5, 2.0],\n]\n"
+        );
+        let e = load_str(&src).to_string();
+        assert!(e.contains(":13: control.vertical[1].points[1]"), "{e}");
+    }
+
+    #[test]
+    fn wrong_version() {
+        let e = load_str(&MINIMAL.replace("version = 1", "version = 7")).to_string();
+        assert!(e.contains(":1: version"), "{e}");
+    }
+
+    fn load_str(src: &str) -> DesignError {
+        match parse_design(src) {
+            Ok(_) => panic!("should fail"),
+            Err(ParseError::Field(f)) => located(Path::new("t.toml"), src, f),
+            Err(ParseError::Syntax { line, message }) => DesignError::Syntax { file: "t.toml".into(), line, message },
+        }
+    }
+}

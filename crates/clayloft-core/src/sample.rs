@@ -1,0 +1,146 @@
+//! Sampling and correspondence (SPEC §1.3): both contours are sampled at N points equally spaced
+//! by arc length, starting where the ray from the anchor towards +x meets the contour, so point i
+//! of one corresponds to point i of the other. A cyclic offset of the upper samples then minimises
+//! the total twist Σ |lowerᵢ − upper₍ᵢ₊ₒ₎|².
+
+use glam::DVec2;
+
+use crate::contour::Contour;
+use crate::geometry::resample_closed;
+
+/// `count` points equally spaced by arc length along the contour, counter-clockwise, starting on
+/// the ray from `anchor` in the +x direction (the outermost crossing if there are several).
+pub fn sample_from_anchor(contour: &Contour, anchor: DVec2, count: usize) -> Vec<DVec2> {
+    let pts = &contour.points;
+    let n = pts.len();
+    // Find the crossing of the ray y = anchor.y, x > anchor.x with the largest x.
+    let mut best: Option<(f64, usize, DVec2)> = None;
+    for i in 0..n {
+        let (a, b) = (pts[i], pts[(i + 1) % n]);
+        let (da, db) = (a.y - anchor.y, b.y - anchor.y);
+        if (da <= 0.0 && db > 0.0) || (da > 0.0 && db <= 0.0) {
+            let f = da / (da - db);
+            let p = a.lerp(b, f);
+            if p.x > anchor.x && best.is_none_or(|(x, _, _)| p.x > x) {
+                best = Some((p.x, i, p));
+            }
+        }
+    }
+    let rotated: Vec<DVec2> = match best {
+        Some((_, i, p)) => {
+            let mut v = Vec::with_capacity(n + 1);
+            v.push(p);
+            v.extend((1..=n).map(|k| pts[(i + k) % n]));
+            v
+        }
+        // The anchor sees no crossing (cannot happen for a closed curve around it); keep order.
+        None => pts.clone(),
+    };
+    resample_closed(&rotated, count)
+}
+
+/// Total twist `Σ |aᵢ − b₍ᵢ₊ₒ₎|²` for offset `o`.
+fn twist(a: &[DVec2], b: &[DVec2], o: usize) -> f64 {
+    let n = a.len();
+    (0..n).map(|i| a[i].distance_squared(b[(i + o) % n])).sum()
+}
+
+/// The cyclic offset `o` minimising total twist between `lower` and `upper` (same length).
+///
+/// Exhaustive for up to 2048 samples; above that, a coarse search with stride `n / 1024` refined
+/// around the best coarse offset.
+pub fn min_twist_offset(lower: &[DVec2], upper: &[DVec2]) -> usize {
+    let n = lower.len();
+    let best_in = |cands: &mut dyn Iterator<Item = usize>| {
+        cands
+            .map(|o| (twist(lower, upper, o), o))
+            .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+            .map(|(_, o)| o)
+            .unwrap_or(0)
+    };
+    if n <= 2048 {
+        return best_in(&mut (0..n));
+    }
+    let stride = n / 1024;
+    let coarse = best_in(&mut (0..n).step_by(stride));
+    best_in(&mut (0..=2 * stride).map(|d| (coarse + n + d - stride) % n))
+}
+
+/// Rotates `upper` by the minimal-twist offset so that `upper[i]` corresponds to `lower[i]`.
+pub fn correspond(lower: &[DVec2], upper: &[DVec2]) -> Vec<DVec2> {
+    let o = min_twist_offset(lower, upper);
+    let n = upper.len();
+    (0..n).map(|i| upper[(i + o) % n]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contour::DENSE_POINTS;
+    use crate::design::ContourSpec;
+    use proptest::prelude::*;
+
+    fn contour(spec: ContourSpec) -> Contour {
+        Contour::from_spec(&spec, DENSE_POINTS).unwrap()
+    }
+
+    #[test]
+    fn circle_samples_start_on_plus_x_and_are_equally_spaced() {
+        let c = contour(ContourSpec::Circle { radius: 40.0 });
+        let s = sample_from_anchor(&c, DVec2::ZERO, 200);
+        assert!(s[0].distance(DVec2::new(40.0, 0.0)) < 1e-9);
+        assert!(s[50].distance(DVec2::new(0.0, 40.0)) < 1e-2);
+        let d0 = s[0].distance(s[1]);
+        for i in 0..200 {
+            let d = s[i].distance(s[(i + 1) % 200]);
+            assert!((d - d0).abs() / d0 < 0.01);
+        }
+    }
+
+    #[test]
+    fn twist_offset_undoes_a_rotation() {
+        let c = contour(ContourSpec::Ellipse { rx: 50.0, ry: 30.0 });
+        let a = sample_from_anchor(&c, DVec2::ZERO, 120);
+        let rotated: Vec<DVec2> = (0..120).map(|i| a[(i + 7) % 120]).collect();
+        assert_eq!(min_twist_offset(&a, &rotated), 113);
+        assert_eq!(correspond(&a, &rotated), a);
+    }
+
+    #[test]
+    fn large_sample_counts_use_the_refined_search() {
+        let c = contour(ContourSpec::Circle { radius: 30.0 });
+        let a = sample_from_anchor(&c, DVec2::ZERO, 5000);
+        let b: Vec<DVec2> = (0..5000).map(|i| a[(i + 1234) % 5000]).collect();
+        assert_eq!(min_twist_offset(&a, &b), 5000 - 1234);
+    }
+
+    /// Arc-length position of `p` along the closed polyline `poly` (p must lie on it).
+    fn arc_position(poly: &[DVec2], p: DVec2) -> f64 {
+        let s = crate::geometry::cumulative_length(poly);
+        let n = poly.len();
+        (0..n)
+            .map(|i| {
+                let (d, f) = crate::geometry::point_segment_distance(p, poly[i], poly[(i + 1) % n]);
+                (d, s[i] + f * (s[i + 1] - s[i]))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, s)| s)
+            .unwrap()
+    }
+
+    proptest! {
+        /// Equal arc-length sampling of any rose curve: the arc between consecutive samples,
+        /// measured along the curve, is within 1 % of the mean.
+        #[test]
+        fn sampling_is_equal_arc_length(r in 20.0..80.0f64, amp in 0.0..0.5f64, k in 1usize..12, n in 30usize..400) {
+            let c = contour(ContourSpec::Rose { radius: r, amplitude: amp * r, petals: k });
+            let s = sample_from_anchor(&c, DVec2::ZERO, n);
+            let pos: Vec<f64> = s.iter().map(|&p| arc_position(&c.points, p)).collect();
+            let total = crate::geometry::closed_length(&c.points);
+            for i in 0..n {
+                let gap = (pos[(i + 1) % n] - pos[i]).rem_euclid(total);
+                prop_assert!((gap - total / n as f64).abs() / (total / n as f64) < 0.01, "gap {gap}");
+            }
+        }
+    }
+}
