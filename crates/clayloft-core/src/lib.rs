@@ -1,9 +1,40 @@
 //! Clayloft core: from a design file to a single spiral G-code path, without a window.
+//!
+//! The pipeline, in order (each stage a function from plain data to plain data):
+//! 1. [`load`] reads and [`validate`]s a [`design::Design`] (SPEC §6);
+//! 2. [`contour`] builds the two closed curves ([`spline`] for user splines), [`align`] puts their
+//!    anchors on the design centre, [`sample`] samples them by arc length and corresponds them;
+//! 3. [`loft`] interpolates between them, [`shape`] adds the [`control`] lines section by
+//!    [`section`] on a layer plan that keeps layer heights printable;
+//! 4. [`constraint`] corrects the overhang locally and [`report`]s each correction;
+//! 5. [`texture`] embeds the periodic waves within the same limits;
+//! 6. [`toolpath`] joins the sections into one spiral, [`gcode`] writes it, [`stl`] meshes the
+//!    wall; [`check`] re-measures any G-code file against the printer's limits.
+//!
+//! [`pipeline`] is the loop over these stages.
 pub mod align;
+pub mod atomic;
+pub mod check;
+pub mod constraint;
 pub mod contour;
+pub mod control;
 pub mod design;
+pub mod gcode;
 pub mod geometry;
+pub mod interp;
 pub mod load;
+pub mod loft;
+pub mod pipeline;
+pub mod report;
 pub mod sample;
+pub mod section;
+pub mod shape;
 pub mod spline;
+pub mod stl;
+pub mod texture;
+pub mod toolpath;
 pub mod validate;
+
+pub use design::Design;
+pub use load::{DesignError, LoadedDesign, load_design};
+pub use pipeline::{PrintJob, run};

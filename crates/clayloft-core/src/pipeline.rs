@@ -1,0 +1,144 @@
+//! The whole pipeline as one loop over the per-stage functions: design → loft → control lines →
+//! constraints → texture → spiral toolpath. The app calls the same stage functions for the
+//! sections an edit touches.
+
+use glam::DVec2;
+
+use crate::constraint::{SurfaceMetrics, clamp_overhang, measure};
+use crate::design::Design;
+use crate::loft::LoftInput;
+use crate::report::{Finding, FindingKind, group_events};
+use crate::section::Section;
+use crate::shape::{LIMIT_MARGIN, ShapeModel};
+use crate::texture::apply_texture;
+use crate::toolpath::{Toolpath, build_toolpath};
+use crate::validate::FieldError;
+
+/// The corrected, textured section surface of a design.
+#[derive(Debug, Clone)]
+pub struct Surface {
+    /// Sections 0 ..= L; section 0 is the bed contact at z = 0.
+    pub sections: Vec<Section>,
+    pub layers: usize,
+    /// Nominal layer pitch, mm.
+    pub layer_pitch: f64,
+    pub center: DVec2,
+    pub findings: Vec<Finding>,
+    pub metrics: SurfaceMetrics,
+}
+
+/// A design turned into a printable job.
+#[derive(Debug, Clone)]
+pub struct PrintJob {
+    pub surface: Surface,
+    pub toolpath: Toolpath,
+}
+
+/// `tan(max_overhang)` with the pipeline's safety margin.
+pub fn overhang_tan_limit(design: &Design) -> f64 {
+    design.printer.max_overhang_deg.to_radians().tan() * LIMIT_MARGIN
+}
+
+/// Corrects the shaped sections against the overhang limit from section `from` upward and
+/// reports what moved.
+pub fn correct_shape(design: &Design, sections: &mut [Section], from: usize) -> Vec<Finding> {
+    let enforce = design.constraints.enforce;
+    let events = clamp_overhang(sections, from, overhang_tan_limit(design), enforce);
+    let limit = design.printer.max_overhang_deg;
+    group_events(&events, FindingKind::Overhang, enforce, 3, |mm| {
+        if enforce {
+            format!("wall leaned past {limit}°; offsets clamped by up to {mm:.2} mm")
+        } else {
+            format!("wall leans past {limit}° by up to {mm:.2} mm per layer")
+        }
+    })
+}
+
+/// Builds the corrected, textured surface of a design.
+pub fn build_surface(design: &Design) -> Result<Surface, FieldError> {
+    let loft = LoftInput::from_design(design)?;
+    let center = loft.center;
+    let (model, mut findings) = ShapeModel::new(design, loft);
+    let mut sections: Vec<Section> = (0..=model.layers).map(|k| model.section(k)).collect();
+    findings.extend(correct_shape(design, &mut sections, 1));
+    if let Some(tex) = &design.texture {
+        let enforce = design.constraints.enforce;
+        let events = apply_texture(&mut sections, tex, overhang_tan_limit(design), enforce);
+        if !events.is_empty() {
+            let columns = events.len();
+            let mut f = group_events(&events, FindingKind::Texture, enforce, usize::MAX, |mm| {
+                if enforce {
+                    format!("texture amplitude lowered by up to {mm:.2} mm on {columns} of the columns to keep the overhang limit")
+                } else {
+                    format!("texture breaks the overhang limit on {columns} columns (up to {mm:.2} mm too deep)")
+                }
+            });
+            findings.append(&mut f);
+        }
+        // Safety net: whatever the column scaling missed (normals turn with the texture).
+        let residual = clamp_overhang(&mut sections, 1, overhang_tan_limit(design) / LIMIT_MARGIN, enforce);
+        findings.extend(group_events(&residual, FindingKind::Texture, enforce, 3, |mm| {
+            format!("textured wall clamped by up to {mm:.2} mm at the overhang limit")
+        }));
+    }
+    let metrics = measure(&sections);
+    let surface = Surface {
+        sections,
+        layers: model.layers,
+        layer_pitch: model.layer_pitch,
+        center,
+        findings,
+        metrics,
+    };
+    check_fits_machine(design, &surface)?;
+    Ok(surface)
+}
+
+/// The printed wall (path ± line_width / 2) must lie on the bed and under the build height.
+fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldError> {
+    let p = &design.printer;
+    let half = p.line_width / 2.0;
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    let mut top = 0.0_f64;
+    for s in &surface.sections {
+        for q in &s.points {
+            lo = lo.min(q.truncate());
+            hi = hi.max(q.truncate());
+            top = top.max(q.z);
+        }
+    }
+    let (lo, hi) = (lo - half, hi + half);
+    let field = if design.shape.center.is_some() { "shape.center" } else { "shape" };
+    if lo.x < 0.0 || hi.x > p.bed_x {
+        return Err(FieldError::new(
+            field,
+            format!(
+                "the vessel spans x = {:.1} … {:.1} mm but the bed is 0 … {} mm (printer.bed_x); make it smaller or move it",
+                lo.x, hi.x, p.bed_x
+            ),
+        ));
+    }
+    if lo.y < 0.0 || hi.y > p.bed_y {
+        return Err(FieldError::new(
+            field,
+            format!(
+                "the vessel spans y = {:.1} … {:.1} mm but the bed is 0 … {} mm (printer.bed_y); make it smaller or move it",
+                lo.y, hi.y, p.bed_y
+            ),
+        ));
+    }
+    if top > p.max_z {
+        return Err(FieldError::new(
+            "shape.height",
+            format!("the rim reaches z = {top:.1} mm, above the build height printer.max_z = {} mm", p.max_z),
+        ));
+    }
+    Ok(())
+}
+
+/// Runs the whole pipeline: surface, then the single spiral toolpath.
+pub fn run(design: &Design) -> Result<PrintJob, FieldError> {
+    let surface = build_surface(design)?;
+    let toolpath = build_toolpath(design, &surface)?;
+    Ok(PrintJob { surface, toolpath })
+}

@@ -1,0 +1,225 @@
+//! The large-scale shape: loft plus control lines, section by section, on a layer plan that keeps
+//! every local layer height printable (SPEC §1.5, §2).
+//!
+//! Section k (k = 0 ..= L) sits at height fraction t = k / L. Its points are
+//! `P(i, t) + d(i, t)·nᵢ` in XY, with d the sum of the vertical control lines, and
+//! `z = k·h + s·Σ_l w_l(t)·dz_l(φᵢ)` with h = height / L and s the horizontal-line scale (1 unless
+//! a constraint needed it lowered). Section 0 is the bed contact at z = 0.
+
+use glam::{DVec2, DVec3};
+
+use crate::control::{HorizontalProfile, VerticalProfile};
+use crate::design::Design;
+use crate::geometry::outward_normals;
+use crate::loft::LoftInput;
+use crate::report::{Finding, FindingKind};
+use crate::section::Section;
+
+/// Safety margin on printer limits: the pipeline aims 2 % inside them so that rounding in the
+/// spiral and the G-code never tips a measurement over.
+pub const LIMIT_MARGIN: f64 = 0.98;
+/// Height-fraction resolution used to plan layers against horizontal control lines.
+const PLAN_STEPS: usize = 512;
+
+/// Everything needed to compute any section of the shaped (uncorrected, untextured) surface.
+#[derive(Debug, Clone)]
+pub struct ShapeModel {
+    pub loft: LoftInput,
+    pub vertical: Vec<VerticalProfile>,
+    pub horizontal: Vec<HorizontalProfile>,
+    /// `hz[l][i]`: full-weight z offset of horizontal line l at sample i.
+    pub hz: Vec<Vec<f64>>,
+    /// Scale applied to all horizontal lines (lowered by constraint enforcement).
+    pub hz_scale: f64,
+    /// Number of layers L.
+    pub layers: usize,
+    /// Nominal layer pitch h = height / L, mm.
+    pub layer_pitch: f64,
+    pub height: f64,
+}
+
+impl ShapeModel {
+    /// Builds the model and plans the layers; returns findings for any horizontal-line scaling.
+    pub fn new(design: &Design, loft: LoftInput) -> (ShapeModel, Vec<Finding>) {
+        let vertical: Vec<_> = design.control.vertical.iter().map(VerticalProfile::new).collect();
+        let horizontal: Vec<_> = design.control.horizontal.iter().map(HorizontalProfile::new).collect();
+        let hz = horizontal
+            .iter()
+            .map(|h| loft.angles.iter().map(|&phi| h.dz_at(phi)).collect())
+            .collect();
+        let mut model = ShapeModel {
+            loft,
+            vertical,
+            horizontal,
+            hz,
+            hz_scale: 1.0,
+            layers: 1,
+            layer_pitch: design.shape.height,
+            height: design.shape.height,
+        };
+        let findings = model.plan_layers(design);
+        (model, findings)
+    }
+
+    /// z offset of sample i at height fraction t from all horizontal lines (scaled).
+    #[inline]
+    fn dz(&self, i: usize, t: f64) -> f64 {
+        let mut dz = 0.0;
+        for (line, values) in self.horizontal.iter().zip(&self.hz) {
+            let w = line.weight_at(t);
+            if w != 0.0 {
+                dz += w * values[i];
+            }
+        }
+        dz * self.hz_scale
+    }
+
+    /// The shaped section k: loft, vertical control offsets along the normal, z with horizontal
+    /// control offsets. This is the per-section entry point the app calls for dirty sections.
+    pub fn section(&self, k: usize) -> Section {
+        let t = k as f64 / self.layers as f64;
+        let n = self.loft.samples();
+        let xy: Vec<DVec2> = (0..n).map(|i| self.loft.point(i, t)).collect();
+        let active: Vec<(&VerticalProfile, f64)> = self
+            .vertical
+            .iter()
+            .map(|v| (v, v.offset_at(t)))
+            .filter(|(_, d)| *d != 0.0)
+            .collect();
+        let normals = if active.is_empty() { Vec::new() } else { outward_normals(&xy) };
+        let z0 = k as f64 * self.layer_pitch;
+        let points = (0..n)
+            .map(|i| {
+                let mut p = xy[i];
+                for (v, d) in &active {
+                    p += normals[i] * (d * v.weight_at(self.loft.angles[i]));
+                }
+                let z = if k == 0 { 0.0 } else { z0 + self.dz(i, t) };
+                DVec3::new(p.x, p.y, z)
+            })
+            .collect();
+        Section { points }
+    }
+
+    /// Sections whose shape a vertical control line's span `(t0, t1)` touches.
+    pub fn sections_in_span(&self, span: (f64, f64)) -> std::ops::RangeInclusive<usize> {
+        let l = self.layers as f64;
+        let lo = (span.0 * l).floor().max(0.0) as usize;
+        let hi = ((span.1 * l).ceil() as usize).min(self.layers);
+        lo..=hi
+    }
+
+    /// Chooses the number of layers L and the horizontal-line scale s.
+    ///
+    /// With `g(t, i) = ∂dz/∂t`, the local layer height is about `(H + s·g) / L`. L is the smallest
+    /// count with `(H + s·g_max) / L ≤ max_layer_height` and at least `H / layer_height`. If then
+    /// `(H + s·g_min) / L < min_layer_height`, or the z range under the nozzle holder exceeds the
+    /// nozzle length, s is lowered (bisection) when enforcing, or the violation is reported.
+    fn plan_layers(&mut self, design: &Design) -> Vec<Finding> {
+        let p = &design.printer;
+        let height = design.shape.height;
+        let hmax = p.max_layer_height * LIMIT_MARGIN;
+        let hmin = p.min_layer_height / LIMIT_MARGIN;
+        let nominal = (height / p.layer_height - 1e-9).ceil().max(1.0) as usize;
+        let (g_min, g_max) = self.dz_gradient_range();
+        let layers_for = |s: f64| {
+            if s * g_max > 0.0 {
+                nominal.max(((height + s * g_max) / hmax - 1e-9).ceil() as usize)
+            } else {
+                nominal
+            }
+        };
+        let thin_ok = |s: f64| s * g_min >= 0.0 || (height + s * g_min) / layers_for(s) as f64 >= hmin;
+        let holder_ok = |s: f64| self.holder_clearance(s, height) <= p.nozzle_length * LIMIT_MARGIN;
+        let ok = |s: f64| thin_ok(s) && holder_ok(s);
+        let mut findings = Vec::new();
+        let mut s = 1.0;
+        if !self.horizontal.is_empty() && !ok(1.0) {
+            let why = if !holder_ok(1.0) {
+                format!("the z range of a layer would exceed the nozzle length ({} mm)", p.nozzle_length)
+            } else {
+                format!("layers would get thinner than min_layer_height ({} mm)", p.min_layer_height)
+            };
+            if design.constraints.enforce {
+                let (mut lo, mut hi) = (0.0, 1.0);
+                for _ in 0..40 {
+                    let mid = 0.5 * (lo + hi);
+                    if ok(mid) { lo = mid } else { hi = mid }
+                }
+                s = lo;
+                findings.push(Finding {
+                    kind: FindingKind::HorizontalLines,
+                    corrected: true,
+                    layers: (0, layers_for(s)),
+                    points: self.loft.samples(),
+                    amount_mm: self.max_abs_dz() * (1.0 - s),
+                    message: format!("horizontal control lines scaled to {:.0} %: {why}", s * 100.0),
+                });
+            } else {
+                findings.push(Finding {
+                    kind: FindingKind::HorizontalLines,
+                    corrected: false,
+                    layers: (0, layers_for(1.0)),
+                    points: self.loft.samples(),
+                    amount_mm: self.max_abs_dz(),
+                    message: format!("horizontal control lines too strong: {why}"),
+                });
+            }
+        }
+        self.hz_scale = s;
+        self.layers = layers_for(s);
+        self.layer_pitch = height / self.layers as f64;
+        findings
+    }
+
+    fn max_abs_dz(&self) -> f64 {
+        self.hz.iter().flatten().fold(0.0, |m: f64, v| m.max(v.abs()))
+    }
+
+    /// Range of ∂dz/∂t over the height and all samples, at scale 1.
+    fn dz_gradient_range(&self) -> (f64, f64) {
+        if self.horizontal.is_empty() {
+            return (0.0, 0.0);
+        }
+        let n = self.loft.samples();
+        let (mut g_min, mut g_max) = (0.0_f64, 0.0_f64);
+        let dt = 1.0 / PLAN_STEPS as f64;
+        for step in 0..PLAN_STEPS {
+            let (t0, t1) = (step as f64 * dt, (step + 1) as f64 * dt);
+            let dw: Vec<f64> = self.horizontal.iter().map(|h| (h.weight_at(t1) - h.weight_at(t0)) / dt).collect();
+            if dw.iter().all(|w| *w == 0.0) {
+                continue;
+            }
+            for i in 0..n {
+                let g: f64 = dw.iter().zip(&self.hz).map(|(w, v)| w * v[i]).sum();
+                g_min = g_min.min(g);
+                g_max = g_max.max(g);
+            }
+        }
+        (g_min, g_max)
+    }
+
+    /// Largest height of already-printed surface above the current layer's lowest point, at
+    /// horizontal-line scale s: `max_t (max_{t' ≤ t} max_i z(t', i) − min_i z(t, i))`.
+    fn holder_clearance(&self, s: f64, height: f64) -> f64 {
+        if self.horizontal.is_empty() {
+            return 0.0;
+        }
+        let n = self.loft.samples();
+        let mut running_max = f64::NEG_INFINITY;
+        let mut worst: f64 = 0.0;
+        for step in 0..=PLAN_STEPS {
+            let t = step as f64 / PLAN_STEPS as f64;
+            let w: Vec<f64> = self.horizontal.iter().map(|h| h.weight_at(t) * s).collect();
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for i in 0..n {
+                let z = t * height + w.iter().zip(&self.hz).map(|(w, v)| w * v[i]).sum::<f64>();
+                lo = lo.min(z);
+                hi = hi.max(z);
+            }
+            running_max = running_max.max(hi);
+            worst = worst.max(running_max - lo);
+        }
+        worst
+    }
+}

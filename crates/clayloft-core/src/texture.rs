@@ -1,0 +1,175 @@
+//! Texture (SPEC §3): small-scale shaping by periodic curve embedding. In the parameter space
+//! x = sample index, y = layer index, each point moves along the outward normal by
+//! `d = f_x(x)·f_y(y)` (product) or `f_x(x) + f_y(y)` (sum).
+//!
+//! Waves of amplitude A and period T, with phase u = frac(t / T):
+//! * sine: `A sin(2πu)`
+//! * triangle: the symmetric (even) triangle wave, `A (1 − 4 min(u, 1 − u))`: +A at u = 0, −A at
+//!   u = ½ — so the paper's period-2 y wave alternates layers in and out (a woven look)
+//! * square: `A sign(sin(2πu))`, exactly 0 at u = 0 and u = ½
+
+use crate::design::{Combine, Texture, Wave, WaveKind};
+
+/// Value of a wave at parameter `t` (samples or layers).
+pub fn wave_value(w: &Wave, t: f64) -> f64 {
+    let u = (t / w.period).rem_euclid(1.0);
+    let a = w.amplitude;
+    match w.wave {
+        WaveKind::Sine => a * (std::f64::consts::TAU * u).sin(),
+        WaveKind::Triangle => a * (1.0 - 4.0 * u.min(1.0 - u)),
+        WaveKind::Square => {
+            const EDGE: f64 = 1e-9;
+            if u < EDGE || (u - 0.5).abs() < EDGE || u > 1.0 - EDGE {
+                0.0
+            } else if u < 0.5 {
+                a
+            } else {
+                -a
+            }
+        }
+    }
+}
+
+/// Texture displacement (mm, along the outward normal) at sample `i` of layer `k` of `layers`.
+/// Zero outside the texture's height range.
+pub fn displacement(tex: &Texture, i: usize, k: usize, layers: usize) -> f64 {
+    let t = k as f64 / layers.max(1) as f64;
+    if t < tex.start - 1e-12 || t > tex.end + 1e-12 {
+        return 0.0;
+    }
+    let x = i as f64 + tex.phase_drift * k as f64;
+    let fx = tex.x.as_ref().map(|w| wave_value(w, x));
+    let fy = tex.y.as_ref().map(|w| wave_value(w, k as f64));
+    match (tex.combine, fx, fy) {
+        (_, None, None) => 0.0,
+        (_, Some(a), None) | (_, None, Some(a)) => a,
+        (Combine::Product, Some(a), Some(b)) => a * b,
+        (Combine::Sum, Some(a), Some(b)) => a + b,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn w(wave: WaveKind, period: f64, amplitude: f64) -> Wave {
+        Wave { wave, period, amplitude }
+    }
+
+    #[test]
+    fn sine_known_values() {
+        let s = w(WaveKind::Sine, 8.0, 2.0);
+        assert!(wave_value(&s, 0.0).abs() < 1e-12);
+        assert!((wave_value(&s, 2.0) - 2.0).abs() < 1e-12);
+        assert!((wave_value(&s, 6.0) + 2.0).abs() < 1e-12);
+        assert!((wave_value(&s, 1.0) - 2.0 * (std::f64::consts::PI / 4.0).sin()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn triangle_known_values() {
+        let t = w(WaveKind::Triangle, 10.0, 2.0);
+        let expected = [2.0, 1.2, 0.4, -0.4, -1.2, -2.0, -1.2, -0.4, 0.4, 1.2, 2.0];
+        for (x, e) in expected.iter().enumerate() {
+            assert!((wave_value(&t, x as f64) - e).abs() < 1e-12, "x={x}");
+        }
+        let y = w(WaveKind::Triangle, 2.0, 2.0);
+        assert_eq!([0.0, 1.0, 2.0, 3.0].map(|k| wave_value(&y, k)), [2.0, -2.0, 2.0, -2.0]);
+    }
+
+    #[test]
+    fn square_known_values() {
+        let q = w(WaveKind::Square, 4.0, 1.5);
+        assert_eq!([0.0, 1.0, 2.0, 3.0, 4.0, 5.0].map(|x| wave_value(&q, x)), [0.0, 1.5, 0.0, -1.5, 0.0, 1.5]);
+    }
+
+    #[test]
+    fn paper_example_product_and_sum() {
+        let mut tex = Texture {
+            combine: Combine::Product,
+            x: Some(w(WaveKind::Triangle, 10.0, 2.0)),
+            y: Some(w(WaveKind::Triangle, 2.0, 2.0)),
+            phase_drift: 0.0,
+            start: 0.0,
+            end: 1.0,
+        };
+        assert_eq!(displacement(&tex, 0, 0, 100), 4.0);
+        assert_eq!(displacement(&tex, 0, 1, 100), -4.0);
+        assert!((displacement(&tex, 1, 1, 100) + 2.4).abs() < 1e-12);
+        tex.combine = Combine::Sum;
+        assert!((displacement(&tex, 1, 1, 100) - (1.2 - 2.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn height_range_and_phase_drift() {
+        let tex = Texture {
+            combine: Combine::Product,
+            x: Some(w(WaveKind::Sine, 8.0, 1.0)),
+            y: None,
+            phase_drift: 2.0,
+            start: 0.5,
+            end: 1.0,
+        };
+        assert_eq!(displacement(&tex, 2, 10, 100), 0.0);
+        // Layer 60, sample 0: x = 0 + 2·60 = 120 = 15 periods → 0; sample 2 → x = 122 → sin(π/2).
+        assert!(displacement(&tex, 0, 60, 100).abs() < 1e-9);
+        assert!((displacement(&tex, 2, 60, 100) - 1.0).abs() < 1e-9);
+    }
+}
+
+/// Displaces every section along its outward normal by the texture, keeping the overhang limit.
+///
+/// For each column (sample index i) the amplitude is lowered by the largest factor `sᵢ ∈ [0, 1]`
+/// such that between any two consecutive sections `|b + sᵢ·Δd| ≤ Δz·tan_limit`, where b is the
+/// normal offset of the untextured wall and Δd the change of displacement. Returns one event
+/// per lowered column (amount = amplitude removed, mm), at the layer where the limit binds.
+pub fn apply_texture(
+    sections: &mut [crate::section::Section],
+    tex: &Texture,
+    tan_limit: f64,
+    enforce: bool,
+) -> Vec<crate::report::PointEvent> {
+    let layers = sections.len().saturating_sub(1);
+    let n = sections.first().map_or(0, |s| s.points.len());
+    let disp: Vec<Vec<f64>> = (0..sections.len())
+        .map(|k| (0..n).map(|i| displacement(tex, i, k, layers)).collect())
+        .collect();
+    let normals: Vec<Vec<glam::DVec2>> = sections.iter().map(|s| s.normals()).collect();
+    // Largest admissible scale per column, and the layer where it binds.
+    let mut scale = vec![(1.0_f64, 0_usize); n];
+    for k in 1..sections.len() {
+        for i in 0..n {
+            let (p, q) = (sections[k].points[i], sections[k - 1].points[i]);
+            let nb = normals[k - 1][i];
+            let b = (p.truncate() - q.truncate()).dot(nb);
+            let dd = disp[k][i] * normals[k][i].dot(nb) - disp[k - 1][i];
+            let limit = (p.z - q.z).max(0.0) * tan_limit;
+            let allowed = if dd > 1e-12 {
+                (limit - b) / dd
+            } else if dd < -1e-12 {
+                (limit + b) / -dd
+            } else {
+                1.0
+            };
+            let allowed = allowed.clamp(0.0, 1.0);
+            if allowed < scale[i].0 {
+                scale[i] = (allowed, k);
+            }
+        }
+    }
+    let mut events = Vec::new();
+    for (i, &(s, k)) in scale.iter().enumerate() {
+        if s < 1.0 - 1e-9 {
+            let amp = disp.iter().map(|d| d[i].abs()).fold(0.0, f64::max);
+            events.push(crate::report::PointEvent { layer: k, sample: i, amount_mm: amp * (1.0 - s) });
+        }
+    }
+    for (k, section) in sections.iter_mut().enumerate() {
+        for (i, p) in section.points.iter_mut().enumerate() {
+            let s = if enforce { scale[i].0 } else { 1.0 };
+            let shift = normals[k][i] * (disp[k][i] * s);
+            p.x += shift.x;
+            p.y += shift.y;
+        }
+    }
+    events
+}

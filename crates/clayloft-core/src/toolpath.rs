@@ -1,0 +1,335 @@
+//! The spiral toolpath (SPEC §4): one continuous extrusion path — a spiral base, a flat first
+//! revolution, a helix whose z rises with arc length while XY blends from section k to k+1, and a
+//! levelled rim.
+//!
+//! Every point carries the local layer thickness (its z minus the z of the point one revolution
+//! below), which sets the extrusion. The helix starts `min_layer_height` above the flat
+//! revolution so that no point is ever thinner than the printer can lay (no 0-thickness wedge),
+//! and the rim is levelled by a partial flat revolution that stops where the thickness would fall
+//! below `min_layer_height`.
+
+use glam::{DVec2, DVec3};
+
+use crate::design::Design;
+use crate::pipeline::Surface;
+use crate::section::Section;
+use crate::validate::FieldError;
+
+/// Points closer than this in XY (mm) are merged, so that no segment extrudes a vanishing amount.
+const MIN_SEGMENT: f64 = 0.01;
+/// Relative flow at the ends of the start/end flow ramps.
+pub const RAMP_FLOW: f64 = 0.25;
+
+/// One point of the path. The segment from the previous point to this one is extruded with this
+/// point's thickness, flow factor and speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathPoint {
+    pub pos: DVec3,
+    /// Local layer thickness, mm.
+    pub thickness: f64,
+    /// Flow factor (ramps), 1 = nominal.
+    pub flow: f64,
+    /// Feed rate, mm/s.
+    pub speed: f64,
+}
+
+/// The whole extrusion path. The first point is where the approach move ends.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Toolpath {
+    pub points: Vec<PathPoint>,
+    /// Number of points that belong to the base (the wall starts after them).
+    pub base_points: usize,
+    /// Number of wall revolutions (flat first revolution, helix and rim).
+    pub revolutions: usize,
+}
+
+impl Toolpath {
+    /// Length of the extrusion path, mm.
+    pub fn length(&self) -> f64 {
+        self.points.windows(2).map(|w| w[0].pos.distance(w[1].pos)).sum()
+    }
+
+    /// Printing time along the path, s (approach and exit not included).
+    pub fn print_time(&self) -> f64 {
+        self.points.windows(2).map(|w| w[0].pos.distance(w[1].pos) / w[1].speed).sum()
+    }
+}
+
+/// Collects path points, merging points that would make a vanishing segment.
+struct PathBuilder {
+    points: Vec<PathPoint>,
+    speed: f64,
+}
+
+impl PathBuilder {
+    fn push(&mut self, pos: DVec3, thickness: f64) {
+        let len = self.points.len();
+        if let Some(last) = self.points.last_mut()
+            && last.pos.truncate().distance(pos.truncate()) < MIN_SEGMENT
+        {
+            // Same place: keep the later height (a pure lift would extrude nothing).
+            if (last.pos.z - pos.z).abs() > 1e-9 && len > 1 {
+                last.pos = pos;
+                last.thickness = last.thickness.max(thickness);
+            }
+            return;
+        }
+        self.points.push(PathPoint { pos, thickness, flow: 1.0, speed: self.speed });
+    }
+}
+
+/// Builds the single continuous spiral path of a surface.
+pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, FieldError> {
+    let p = &design.printer;
+    let sections = &surface.sections;
+    let layers = surface.layers;
+    let h = surface.layer_pitch;
+    let a = p.min_layer_height;
+    let base = design.shape.base_layers.min(layers.saturating_sub(1));
+    let n = sections[0].points.len();
+    let mut b = PathBuilder { points: Vec::with_capacity((layers + 2) * (n + 1)), speed: p.print_speed };
+
+    // 1. Spiral base: layers 1 ..= base, alternating direction so the last one ends at the wall.
+    for layer in 1..=base {
+        let geometry = base_layer(&sections[layer], surface.center, p.line_width, layer as f64 * h)
+            .ok_or_else(|| {
+                FieldError::new(
+                    "shape.base_layers",
+                    "the lower contour is not star-shaped around its centre, so a spiral base cannot fill it; use base_layers = 0",
+                )
+            })?;
+        let outward = (base - layer) % 2 == 0;
+        let start = b.points.len();
+        let ordered: Box<dyn Iterator<Item = &DVec3>> =
+            if outward { Box::new(geometry.iter()) } else { Box::new(geometry.iter().rev()) };
+        for q in ordered {
+            b.push(*q, h);
+        }
+        apply_min_layer_time(&mut b.points, start, p.min_layer_time);
+    }
+    let base_points = b.points.len();
+
+    // 2. Flat first revolution (only without a base: the base's last layer ends with it).
+    let first = base.max(1);
+    let flat_z = first as f64 * h;
+    let mut z_below: Vec<f64> = vec![flat_z; n];
+    if base == 0 {
+        let ring = &sections[first];
+        let start = b.points.len();
+        for i in 0..=n {
+            let q = ring.points[i % n];
+            b.push(DVec3::new(q.x, q.y, flat_z), flat_z);
+        }
+        apply_min_layer_time(&mut b.points, start, p.min_layer_time);
+    }
+    let wall_start = b.points.len();
+    let mut revolutions = 1;
+
+    // 3. The helix: revolution k goes from section k to k+1.
+    for k in first..layers {
+        let (lo, hi) = (&sections[k], &sections[k + 1]);
+        let frac = arc_fractions(lo);
+        let start = b.points.len();
+        let mut z_now = vec![0.0; n];
+        for i in 1..=n {
+            let f = frac[i];
+            let j = i % n;
+            let xy = lo.points[j].truncate().lerp(hi.points[j].truncate(), f);
+            let z = if k == first {
+                // Leave the flat revolution by at least the minimum layer height.
+                let z0 = flat_z + a;
+                z0 + (hi.points[j].z - z0) * f
+            } else {
+                lo.points[j].z + (hi.points[j].z - lo.points[j].z) * f
+            };
+            let thickness = z - z_below[j];
+            b.push(DVec3::new(xy.x, xy.y, z), thickness);
+            z_now[j] = z;
+        }
+        z_below = z_now;
+        apply_min_layer_time(&mut b.points, start, p.min_layer_time);
+        revolutions += 1;
+    }
+
+    // 4. Levelled rim: a flat partial revolution at the top section's height while the layer
+    //    under it is at least min_layer_height thinner.
+    let top = &sections[layers];
+    let start = b.points.len();
+    for i in 1..n {
+        let q = top.points[i];
+        let thickness = q.z - z_below[i];
+        if thickness < a {
+            break;
+        }
+        b.push(q, thickness);
+    }
+    if b.points.len() > start {
+        apply_min_layer_time(&mut b.points, start, p.min_layer_time);
+        revolutions += 1;
+    }
+
+    let mut points = b.points;
+    apply_flow_ramps(&mut points[wall_start..], p.flow_ramp_start, p.flow_ramp_end);
+    Ok(Toolpath { points, base_points, revolutions })
+}
+
+/// Fraction of the section's closed length reached at each vertex: `f[i] = s_i / L`, i = 0 ..= n.
+fn arc_fractions(section: &Section) -> Vec<f64> {
+    let xy = section.xy();
+    let s = crate::geometry::cumulative_length(&xy);
+    let total = s[s.len() - 1].max(1e-12);
+    s.iter().map(|v| v / total).collect()
+}
+
+/// One flat base layer at height `z`: an Archimedean-like spiral of the section scaled about the
+/// centre, `c + σ(P_i − c)` with σ rising from `σ₀` to 1 over whole turns, so that neighbouring
+/// turns are at most one line width apart, then the full perimeter. Ends at the section's
+/// point 0. `None` if the section is not star-shaped around the centre.
+fn base_layer(section: &Section, center: DVec2, line_width: f64, z: f64) -> Option<Vec<DVec3>> {
+    let xy = section.xy();
+    let n = xy.len();
+    // Star-shaped: the angle seen from the centre must keep increasing all the way round.
+    let mut total_turn = 0.0;
+    for i in 0..n {
+        let d = crate::control::angle_difference((xy[(i + 1) % n] - center).to_angle(), (xy[i] - center).to_angle());
+        if d <= 0.0 {
+            return None;
+        }
+        total_turn += d;
+    }
+    if (total_turn - std::f64::consts::TAU).abs() > 1e-6 {
+        return None;
+    }
+    let r_max = xy.iter().map(|p| p.distance(center)).fold(0.0, f64::max);
+    let sigma0 = (0.5 * line_width / r_max).min(1.0);
+    let turns = (((1.0 - sigma0) * r_max) / line_width).ceil().max(1.0) as usize;
+    let mut out = Vec::with_capacity((turns + 1) * n + 1);
+    for turn in 0..turns {
+        for (i, p) in xy.iter().enumerate() {
+            let sigma = sigma0 + (1.0 - sigma0) * (turn as f64 + i as f64 / n as f64) / turns as f64;
+            let q = center + (*p - center) * sigma;
+            out.push(DVec3::new(q.x, q.y, z));
+        }
+    }
+    for i in 0..=n {
+        let q = xy[i % n];
+        out.push(DVec3::new(q.x, q.y, z));
+    }
+    Some(out)
+}
+
+/// Slows the revolution `points[start..]` down so that it takes at least `min_time` seconds
+/// (each point's incoming segment counts, including the one from `points[start − 1]`).
+fn apply_min_layer_time(points: &mut [PathPoint], start: usize, min_time: f64) {
+    if min_time <= 0.0 || points.len() < 2 {
+        return;
+    }
+    let from = start.max(1);
+    let time: f64 = (from..points.len()).map(|i| points[i - 1].pos.distance(points[i].pos) / points[i].speed).sum();
+    if time < min_time && time > 0.0 {
+        let factor = time / min_time;
+        for q in points[from..].iter_mut() {
+            q.speed *= factor;
+        }
+    }
+}
+
+/// Linear flow ramps over the first `start_len` and last `end_len` mm of the wall, from and to
+/// [`RAMP_FLOW`].
+fn apply_flow_ramps(points: &mut [PathPoint], start_len: f64, end_len: f64) {
+    if points.len() < 2 {
+        return;
+    }
+    let mut s = vec![0.0; points.len()];
+    for i in 1..points.len() {
+        s[i] = s[i - 1] + points[i - 1].pos.distance(points[i].pos);
+    }
+    let total = s[s.len() - 1];
+    for (q, &si) in points.iter_mut().zip(&s) {
+        if start_len > 0.0 && si < start_len {
+            q.flow *= RAMP_FLOW + (1.0 - RAMP_FLOW) * si / start_len;
+        }
+        let from_end = total - si;
+        if end_len > 0.0 && from_end < end_len {
+            q.flow *= RAMP_FLOW + (1.0 - RAMP_FLOW) * from_end / end_len;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::parse_design;
+    use crate::pipeline::run;
+
+    fn design(extra: &str) -> Design {
+        parse_design(&format!(
+            "version = 1\n[shape]\nheight = 20.0\nsamples = 90\nbase_layers = 0\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n{extra}"
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn cylinder_spiral_rises_by_arc_length_and_is_continuous() {
+        let d = design("");
+        let job = run(&d).unwrap();
+        let pts = &job.toolpath.points;
+        // Flat first revolution at z = 1.
+        assert!(pts[..=90].iter().all(|q| (q.pos.z - 1.0).abs() < 1e-12));
+        // Helix: z rises monotonically to the top.
+        for w in pts[91..].windows(2) {
+            assert!(w[1].pos.z >= w[0].pos.z - 1e-12);
+        }
+        // On a circle arc length ∝ index: halfway round revolution 3 (sections 2→3) z = 2.5.
+        let mid = &pts[90 + 90 + 45];
+        assert!((mid.pos.z - 2.5).abs() < 1e-9, "{}", mid.pos.z);
+        // No segment longer than the sample spacing: no travel anywhere.
+        let step = std::f64::consts::TAU * 30.0 / 90.0;
+        for w in pts.windows(2) {
+            assert!(w[0].pos.truncate().distance(w[1].pos.truncate()) < step * 1.01);
+        }
+        // Every point within the printable layer heights.
+        for q in pts {
+            assert!(q.thickness >= 0.25 - 1e-9 && q.thickness <= 1.0 + 1e-9, "{}", q.thickness);
+        }
+        assert!((pts.last().unwrap().pos.z - 20.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn base_spiral_fills_from_the_centre_and_joins_the_wall() {
+        let d = design("").clone();
+        let mut d = d;
+        d.shape.base_layers = 2;
+        let job = run(&d).unwrap();
+        let tp = &job.toolpath;
+        assert!(tp.base_points > 0);
+        let c = job.surface.center;
+        // Two base layers: first inward (starts at the edge), second outward (starts at centre).
+        let first = tp.points[0].pos.truncate();
+        assert!((first.distance(c) - 30.0).abs() < 1e-6);
+        let nearest = tp.points[..tp.base_points].iter().map(|q| q.pos.truncate().distance(c)).fold(f64::MAX, f64::min);
+        assert!(nearest <= 1.5 + 1e-9, "{nearest}");
+        // Base layers sit at z = 1 and 2.
+        assert!(tp.points[..tp.base_points].iter().all(|q| q.pos.z == 1.0 || q.pos.z == 2.0));
+    }
+
+    #[test]
+    fn min_layer_time_slows_small_layers() {
+        let d = design("[printer]\nmin_layer_time = 30.0\n");
+        let job = run(&d).unwrap();
+        // Circumference 188.5 mm at 20 mm/s = 9.4 s < 30 s: speed 6.28 mm/s.
+        let q = &job.toolpath.points[200];
+        let chord = 2.0 * 30.0 * (std::f64::consts::PI / 90.0).sin();
+        assert!((q.speed - 90.0 * chord / 30.0).abs() < 0.02, "{}", q.speed);
+    }
+
+    #[test]
+    fn flow_ramps_start_low_and_reach_nominal() {
+        let d = design("[printer]\nflow_ramp_start = 50.0\nflow_ramp_end = 20.0\n");
+        let tp = run(&d).unwrap().toolpath;
+        let wall = &tp.points[91..];
+        assert!((wall[0].flow - RAMP_FLOW).abs() < 0.05);
+        assert_eq!(wall[200].flow, 1.0);
+        assert!((wall.last().unwrap().flow - RAMP_FLOW).abs() < 1e-9);
+    }
+}
