@@ -1,1 +1,307 @@
-//! TODO
+//! G-code (SPEC §5): Marlin-flavoured, plain ASCII, one command per line, deterministic.
+//!
+//! Extrusion per segment: `V = line_width × thickness × length_xy × flow`, and
+//! `E = V / (π·feed_diameter²/4) × flow_multiplier`. Thickness is the local layer height of the
+//! segment's end point (its z minus the z one revolution below), so extrusion follows the
+//! changing layer height of the spiral. Numbers are formatted with fixed decimals by integer
+//! arithmetic: writing is I/O-bound, not formatting-bound.
+
+use std::io::{self, Write};
+
+use crate::design::{Design, ExtrusionMode};
+use crate::pipeline::PrintJob;
+use crate::toolpath::Toolpath;
+
+/// Height above the first and last point for the approach and exit moves, mm.
+pub const CLEARANCE: f64 = 10.0;
+
+/// Key of the header line that carries the printer limits for `clayloft check`.
+pub const LIMITS_KEY: &str = "; clayloft-limits:";
+
+/// Summary of a written (or writable) job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobSummary {
+    pub layers: usize,
+    pub points: usize,
+    pub path_length_mm: f64,
+    /// Estimated time including approach and exit, s.
+    pub estimated_time_s: f64,
+    /// Extruded volume, mm³.
+    pub volume_mm3: f64,
+}
+
+/// Approach and exit moves: (approach start height, exit height).
+fn clearance_heights(design: &Design, tp: &Toolpath) -> (f64, f64) {
+    let first = tp.points.first().map_or(0.0, |p| p.pos.z);
+    let last = tp.points.last().map_or(0.0, |p| p.pos.z);
+    let max_z = design.printer.max_z;
+    ((first + CLEARANCE).min(max_z), (last + CLEARANCE).min(max_z))
+}
+
+/// Extruded volume of the segment ending at point `i` (i ≥ 1), mm³.
+#[inline]
+fn segment_volume(design: &Design, tp: &Toolpath, i: usize) -> f64 {
+    let (a, b) = (&tp.points[i - 1], &tp.points[i]);
+    let len = a.pos.truncate().distance(b.pos.truncate());
+    design.printer.line_width * b.thickness.max(0.0) * len * b.flow
+}
+
+/// Length, time and volume of a job.
+pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
+    let tp = &job.toolpath;
+    let (z_in, z_out) = clearance_heights(design, tp);
+    let travel = match (tp.points.first(), tp.points.last()) {
+        (Some(f), Some(l)) => (z_in - f.pos.z).abs() * 2.0 + f.pos.truncate().length() + (z_out - l.pos.z).abs(),
+        _ => 0.0,
+    };
+    let volume = (1..tp.points.len()).map(|i| segment_volume(design, tp, i)).sum();
+    JobSummary {
+        layers: job.surface.layers,
+        points: tp.points.len(),
+        path_length_mm: tp.length(),
+        estimated_time_s: tp.print_time() + travel / design.printer.travel_speed,
+        volume_mm3: volume,
+    }
+}
+
+/// `1h 02m 03s` style duration.
+pub fn format_duration(seconds: f64) -> String {
+    let s = seconds.max(0.0).round() as u64;
+    let (h, m, s) = (s / 3600, (s / 60) % 60, s % 60);
+    if h > 0 { format!("{h}h {m:02}m {s:02}s") } else { format!("{m}m {s:02}s") }
+}
+
+/// Writes the whole G-code program of a job.
+pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::Result<()> {
+    let p = &design.printer;
+    let tp = &job.toolpath;
+    let summary = summarize(design, job);
+    let mut head = String::new();
+    use std::fmt::Write as _;
+    let _ = writeln!(head, "; Clayloft {} — one continuous spiral for clay paste extrusion", env!("CARGO_PKG_VERSION"));
+    let _ = writeln!(head, "; design: {}", design.name.replace(['\n', '\r'], " "));
+    let _ = writeln!(
+        head,
+        "; layers: {} (pitch {:.3} mm), points: {}, path length: {:.1} mm, clay volume: {:.1} cm3",
+        summary.layers,
+        job.surface.layer_pitch,
+        summary.points,
+        summary.path_length_mm,
+        summary.volume_mm3 / 1000.0
+    );
+    let _ = writeln!(head, "; estimated time: {} ({:.0} s)", format_duration(summary.estimated_time_s), summary.estimated_time_s);
+    let _ = writeln!(
+        head,
+        "; settings: nozzle {} mm, line width {} mm, layer height {} mm ({} .. {}), speed {} mm/s, feed diameter {} mm, flow x{}, {} E, min layer time {} s",
+        p.nozzle_diameter,
+        p.line_width,
+        p.layer_height,
+        p.min_layer_height,
+        p.max_layer_height,
+        p.print_speed,
+        p.feed_diameter,
+        p.flow_multiplier,
+        match p.extrusion {
+            ExtrusionMode::Relative => "relative",
+            ExtrusionMode::Absolute => "absolute",
+        },
+        p.min_layer_time
+    );
+    let _ = writeln!(
+        head,
+        "{LIMITS_KEY} bed_x={} bed_y={} max_z={} line_width={} min_layer_height={} max_layer_height={} nozzle_length={} max_overhang_deg={}",
+        p.bed_x, p.bed_y, p.max_z, p.line_width, p.min_layer_height, p.max_layer_height, p.nozzle_length, p.max_overhang_deg
+    );
+    for f in &job.surface.findings {
+        let _ = writeln!(head, "; {f}");
+    }
+    let _ = writeln!(head, "G21 ; millimetres");
+    let _ = writeln!(head, "G90 ; absolute positions");
+    let _ = writeln!(
+        head,
+        "{}",
+        match p.extrusion {
+            ExtrusionMode::Relative => "M83 ; relative extrusion",
+            ExtrusionMode::Absolute => "M82 ; absolute extrusion",
+        }
+    );
+    let _ = writeln!(head, "G92 E0");
+    out.write_all(head.as_bytes())?;
+
+    let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+    let (z_in, z_out) = clearance_heights(design, tp);
+    let travel_f = p.travel_speed * 60.0;
+    if let Some(first) = tp.points.first() {
+        buf.extend_from_slice(b"G0 Z");
+        put_fixed(&mut buf, z_in, 3);
+        buf.extend_from_slice(b" F");
+        put_fixed(&mut buf, travel_f, 0);
+        buf.extend_from_slice(b" ; approach\nG0 X");
+        put_fixed(&mut buf, first.pos.x, 3);
+        buf.extend_from_slice(b" Y");
+        put_fixed(&mut buf, first.pos.y, 3);
+        buf.extend_from_slice(b"\nG0 Z");
+        put_fixed(&mut buf, first.pos.z, 3);
+        buf.push(b'\n');
+    }
+    let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
+    let e_per_mm3 = p.flow_multiplier / feed_area;
+    let mut e_total = 0.0;
+    let mut last_speed = f64::NAN;
+    for i in 1..tp.points.len() {
+        let q = &tp.points[i];
+        let e = segment_volume(design, tp, i) * e_per_mm3;
+        buf.extend_from_slice(b"G1 X");
+        put_fixed(&mut buf, q.pos.x, 3);
+        buf.extend_from_slice(b" Y");
+        put_fixed(&mut buf, q.pos.y, 3);
+        buf.extend_from_slice(b" Z");
+        put_fixed(&mut buf, q.pos.z, 3);
+        buf.extend_from_slice(b" E");
+        match p.extrusion {
+            ExtrusionMode::Relative => put_fixed(&mut buf, e, 5),
+            ExtrusionMode::Absolute => {
+                e_total += e;
+                put_fixed(&mut buf, e_total, 5)
+            }
+        }
+        if q.speed != last_speed {
+            buf.extend_from_slice(b" F");
+            put_fixed(&mut buf, q.speed * 60.0, 1);
+            last_speed = q.speed;
+        }
+        buf.push(b'\n');
+        if buf.len() > (1 << 16) - 128 {
+            out.write_all(&buf)?;
+            buf.clear();
+        }
+    }
+    if !tp.points.is_empty() {
+        buf.extend_from_slice(b"G0 Z");
+        put_fixed(&mut buf, z_out, 3);
+        buf.extend_from_slice(b" F");
+        put_fixed(&mut buf, travel_f, 0);
+        buf.extend_from_slice(b" ; exit\n");
+    }
+    buf.extend_from_slice(b"; end\n");
+    out.write_all(&buf)
+}
+
+/// Appends `v` with exactly `decimals` digits after the point (none and no point for 0),
+/// rounded half away from zero; `-0` is written as `0`.
+pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
+    let scale = 10u64.pow(decimals) as f64;
+    let scaled = (v.abs() * scale).round();
+    if !scaled.is_finite() || scaled >= 9.0e18 {
+        // Out of range for integer formatting (never for a real printer); fall back.
+        buf.extend_from_slice(format!("{v:.*}", decimals as usize).as_bytes());
+        return;
+    }
+    let mut n = scaled as u64;
+    if v < 0.0 && n != 0 {
+        buf.push(b'-');
+    }
+    let mut digits = [0u8; 24];
+    let mut len = 0;
+    loop {
+        digits[len] = b'0' + (n % 10) as u8;
+        n /= 10;
+        len += 1;
+        if n == 0 && len > decimals as usize {
+            break;
+        }
+    }
+    for k in (0..len).rev() {
+        buf.push(digits[k]);
+        if k == decimals as usize && decimals > 0 {
+            buf.push(b'.');
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixed(v: f64, d: u32) -> String {
+        let mut b = Vec::new();
+        put_fixed(&mut b, v, d);
+        String::from_utf8(b).unwrap()
+    }
+
+    #[test]
+    fn fixed_formatting() {
+        assert_eq!(fixed(12.3456, 3), "12.346");
+        assert_eq!(fixed(0.0004, 3), "0.000");
+        assert_eq!(fixed(-0.0004, 3), "0.000");
+        assert_eq!(fixed(-1.5, 3), "-1.500");
+        assert_eq!(fixed(0.05, 5), "0.05000");
+        assert_eq!(fixed(3000.0, 0), "3000");
+        assert_eq!(fixed(7.0, 1), "7.0");
+        assert_eq!(fixed(1e300, 2).len(), format!("{:.2}", 1e300).len());
+    }
+
+    #[test]
+    fn durations() {
+        assert_eq!(format_duration(3723.0), "1h 02m 03s");
+        assert_eq!(format_duration(59.6), "1m 00s");
+    }
+
+    fn job(extra: &str) -> (Design, PrintJob) {
+        let d = crate::load::parse_design(&format!(
+            "version = 1\nname = \"t\"\n[shape]\nheight = 10.0\nsamples = 60\nbase_layers = 0\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n{extra}"
+        ))
+        .unwrap();
+        let j = crate::pipeline::run(&d).unwrap();
+        (d, j)
+    }
+
+    fn gcode(d: &Design, j: &PrintJob) -> String {
+        let mut v = Vec::new();
+        write_gcode(d, j, &mut v).unwrap();
+        String::from_utf8(v).unwrap()
+    }
+
+    #[test]
+    fn extrusion_follows_the_volume_formula() {
+        let (d, j) = job("");
+        let text = gcode(&d, &j);
+        // Wall segment in the steady helix: E = w·h·len / (π·3²/4), len = chord of a 30 mm circle in 60 steps.
+        let chord = 2.0 * 30.0 * (std::f64::consts::PI / 60.0).sin();
+        let e_expected = 3.0 * 1.0 * chord / (std::f64::consts::PI * 9.0 / 4.0);
+        let line = text.lines().filter(|l| l.starts_with("G1")).nth(300).unwrap();
+        let e: f64 = line.split(' ').find(|w| w.starts_with('E')).unwrap()[1..].parse().unwrap();
+        assert!((e - e_expected).abs() < 2e-3 * e_expected, "{e} vs {e_expected}: {line}");
+        assert!(text.contains("M83"));
+        assert!(text.contains("; estimated time:"));
+        assert!(text.contains(LIMITS_KEY));
+    }
+
+    #[test]
+    fn absolute_mode_accumulates_to_the_same_total() {
+        let (d, j) = job("");
+        let (da, ja) = job("[printer]\nextrusion = \"absolute\"\n");
+        let rel: f64 = gcode(&d, &j)
+            .lines()
+            .filter(|l| l.starts_with("G1"))
+            .map(|l| l.split(' ').find(|w| w.starts_with('E')).unwrap()[1..].parse::<f64>().unwrap())
+            .sum();
+        let abs_text = gcode(&da, &ja);
+        assert!(abs_text.contains("M82"));
+        let last_e: f64 = abs_text
+            .lines()
+            .filter(|l| l.starts_with("G1"))
+            .last()
+            .map(|l| l.split(' ').find(|w| w.starts_with('E')).unwrap()[1..].parse().unwrap())
+            .unwrap();
+        assert!((rel - last_e).abs() < 1e-3 * rel, "{rel} {last_e}");
+    }
+
+    #[test]
+    fn output_is_deterministic_and_textured_prints_longer() {
+        let (d, j) = job("");
+        assert_eq!(gcode(&d, &j), gcode(&d, &crate::pipeline::run(&d).unwrap()));
+        let (dt, jt) = job("[texture]\n[texture.x]\nwave = \"sine\"\nperiod = 6\namplitude = 1.0\n");
+        assert!(summarize(&dt, &jt).estimated_time_s > summarize(&d, &j).estimated_time_s);
+    }
+}
