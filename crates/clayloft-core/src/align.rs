@@ -32,7 +32,12 @@ mod tests {
     #[test]
     fn anchor_of_an_offset_triangle() {
         // Leftmost (0, 0), rightmost (10, 4): anchor (5, 2).
-        let c = Contour::from_points(vec![DVec2::new(0.0, 0.0), DVec2::new(10.0, 4.0), DVec2::new(3.0, 9.0)]).unwrap();
+        let c = Contour::from_points(vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(10.0, 4.0),
+            DVec2::new(3.0, 9.0),
+        ])
+        .unwrap();
         assert!(anchor(&c).distance(DVec2::new(5.0, 2.0)) < 1e-12);
         let moved = align(&c, DVec2::new(90.0, 95.0));
         assert!(anchor(&moved).distance(DVec2::new(90.0, 95.0)) < 1e-12);

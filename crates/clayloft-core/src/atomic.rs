@@ -19,7 +19,10 @@ pub fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), WriteError> {
-    let err = |reason: String| WriteError { file: path.display().to_string(), reason };
+    let err = |reason: String| WriteError {
+        file: path.display().to_string(),
+        reason,
+    };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -61,7 +64,11 @@ mod tests {
         });
         assert!(r.is_err());
         assert!(!failed.exists());
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary left");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary left"
+        );
     }
 
     #[test]

@@ -53,7 +53,9 @@ impl Limits {
         let line = text.lines().take(200).find(|l| l.starts_with(LIMITS_KEY))?;
         let mut l = Limits::from(&Printer::default());
         for kv in line[LIMITS_KEY.len()..].split_whitespace() {
-            let Some((k, v)) = kv.split_once('=') else { continue };
+            let Some((k, v)) = kv.split_once('=') else {
+                continue;
+            };
             let Ok(v) = v.parse::<f64>() else { continue };
             if !v.is_finite() || v <= 0.0 {
                 continue;
@@ -116,7 +118,10 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
                         message: format!("`{w}` is not a number"),
                     })?;
                     if !v.is_finite() {
-                        return Err(GcodeError { line, message: format!("`{w}` is not finite") });
+                        return Err(GcodeError {
+                            line,
+                            message: format!("`{w}` is not finite"),
+                        });
                     }
                     return Ok(Some(v));
                 }
@@ -161,11 +166,19 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
                     }
                 }
             }
-            "G20" => return Err(GcodeError { line, message: "inch units (G20) are not supported".into() }),
+            "G20" => {
+                return Err(GcodeError {
+                    line,
+                    message: "inch units (G20) are not supported".into(),
+                });
+            }
             "G28" => pos = DVec3::ZERO,
             c if c.starts_with(['G', 'M', 'T', 'N', 'F', 'S']) => {}
             other => {
-                return Err(GcodeError { line, message: format!("`{other}` is not a G-code command") });
+                return Err(GcodeError {
+                    line,
+                    message: format!("`{other}` is not a G-code command"),
+                });
             }
         }
         let _ = words;
@@ -207,20 +220,41 @@ impl CheckReport {
 
 impl fmt::Display for CheckReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "moves: {} ({} extruding), path length {:.1} mm", self.moves, self.extruding_moves, self.path_length_mm)?;
         writeln!(
             f,
-            "extent: x {:.1} … {:.1}, y {:.1} … {:.1}, z {:.2} … {:.2} mm",
-            self.bounds_min.x, self.bounds_max.x, self.bounds_min.y, self.bounds_max.y, self.bounds_min.z, self.bounds_max.z
+            "moves: {} ({} extruding), path length {:.1} mm",
+            self.moves, self.extruding_moves, self.path_length_mm
+        )?;
+        writeln!(
+            f,
+            "printed extent: x {:.1} … {:.1}, y {:.1} … {:.1}, z {:.2} … {:.2} mm",
+            self.bounds_min.x,
+            self.bounds_max.x,
+            self.bounds_min.y,
+            self.bounds_max.y,
+            self.bounds_min.z,
+            self.bounds_max.z
         )?;
         writeln!(f, "max overhang: {:.1}°", self.max_overhang_deg)?;
-        writeln!(f, "layer height: {:.3} … {:.3} mm", self.min_layer_height, self.max_layer_height)?;
-        writeln!(f, "printed part above nozzle tip: up to {:.2} mm", self.max_rise_above_tip)?;
+        writeln!(
+            f,
+            "layer height: {:.3} … {:.3} mm",
+            self.min_layer_height, self.max_layer_height
+        )?;
+        writeln!(
+            f,
+            "printed part above nozzle tip: up to {:.2} mm",
+            self.max_rise_above_tip
+        )?;
         if self.ok() {
             write!(f, "all limits hold")
         } else {
             for v in &self.violations {
-                writeln!(f, "VIOLATION {}: {} moves, worst {:.3}, first at line {} ({})", v.what, v.count, v.worst, v.first_line, v.detail)?;
+                writeln!(
+                    f,
+                    "VIOLATION {}: {} moves, worst {:.3}, first at line {} ({})",
+                    v.what, v.count, v.worst, v.first_line, v.detail
+                )?;
             }
             write!(f, "{} limit(s) broken", self.violations.len())
         }
@@ -250,20 +284,35 @@ impl Tally {
 pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeError> {
     let (moves, start) = parse_moves(text)?;
     if moves.is_empty() {
-        return Err(GcodeError { line: 1, message: "there are no moves to check".into() });
+        return Err(GcodeError {
+            line: 1,
+            message: "there are no moves to check".into(),
+        });
     }
-    let mut report = CheckReport { moves: moves.len(), ..Default::default() };
+    let mut report = CheckReport {
+        moves: moves.len(),
+        ..Default::default()
+    };
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    let (mut outside, mut travel, mut retract) = (Tally::default(), Tally::default(), Tally::default());
+    let (mut outside, mut travel, mut retract) =
+        (Tally::default(), Tally::default(), Tally::default());
     let first_ext = moves.iter().position(|m| m.de > 0.0);
     let last_ext = moves.iter().rposition(|m| m.de > 0.0);
     let mut prev = start;
     for (k, m) in moves.iter().enumerate() {
-        lo = lo.min(m.to);
-        hi = hi.max(m.to);
+        if m.de > 0.0 {
+            lo = lo.min(m.to);
+            hi = hi.max(m.to);
+        }
         let eps = 1e-6;
-        if m.to.x < -eps || m.to.y < -eps || m.to.x > limits.bed_x + eps || m.to.y > limits.bed_y + eps || m.to.z < -eps || m.to.z > limits.max_z + eps {
+        if m.to.x < -eps
+            || m.to.y < -eps
+            || m.to.x > limits.bed_x + eps
+            || m.to.y > limits.bed_y + eps
+            || m.to.z < -eps
+            || m.to.z > limits.max_z + eps
+        {
             outside.add(0.0, m.line);
         }
         if m.de < 0.0 {
@@ -279,15 +328,20 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
         }
         prev = m.to;
     }
-    report.bounds_min = lo;
-    report.bounds_max = hi;
+    if lo.is_finite() {
+        report.bounds_min = lo;
+        report.bounds_max = hi;
+    }
     if outside.count > 0 {
         report.violations.push(Violation {
             what: "outside the machine",
             count: outside.count,
             worst: 0.0,
             first_line: outside.first_line,
-            detail: format!("bed 0 … {} × 0 … {} mm, height 0 … {} mm", limits.bed_x, limits.bed_y, limits.max_z),
+            detail: format!(
+                "bed 0 … {} × 0 … {} mm, height 0 … {} mm",
+                limits.bed_x, limits.bed_y, limits.max_z
+            ),
         });
     }
     if travel.count > 0 {
@@ -332,11 +386,18 @@ struct SegmentGrid {
 
 impl SegmentGrid {
     fn key(&self, p: DVec2, z: f64) -> (i32, i32, i32) {
-        ((p.x / self.cell).floor() as i32, (p.y / self.cell).floor() as i32, (z / self.band).floor() as i32)
+        (
+            (p.x / self.cell).floor() as i32,
+            (p.y / self.cell).floor() as i32,
+            (z / self.band).floor() as i32,
+        )
     }
 
     fn insert(&mut self, id: u32, a: DVec3, b: DVec3) {
-        let (k0, k1) = (self.key(a.truncate().min(b.truncate()), a.z.min(b.z)), self.key(a.truncate().max(b.truncate()), a.z.max(b.z)));
+        let (k0, k1) = (
+            self.key(a.truncate().min(b.truncate()), a.z.min(b.z)),
+            self.key(a.truncate().max(b.truncate()), a.z.max(b.z)),
+        );
         for x in k0.0..=k1.0 {
             for y in k0.1..=k1.1 {
                 for z in k0.2..=k1.2 {
@@ -353,23 +414,35 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
     let gap = 3.0 * radius;
     let below_tol = 0.25 * limits.min_layer_height;
     let reach = 2.0 * limits.max_layer_height + below_tol;
-    let mut grid = SegmentGrid { cell: radius, band: limits.max_layer_height, cells: HashMap::new() };
+    let mut grid = SegmentGrid {
+        cell: radius,
+        band: limits.max_layer_height,
+        cells: HashMap::new(),
+    };
     let mut cum = vec![0.0; v.len()];
     for j in 1..v.len() {
         cum[j] = cum[j - 1] + v[j - 1].distance(v[j]);
     }
     report.path_length_mm = cum[v.len() - 1];
-    let (mut thin, mut thick, mut lean, mut unsupported, mut collide) =
-        (Tally::default(), Tally::default(), Tally::default(), Tally::default(), Tally::default());
+    let (mut thin, mut thick, mut lean, mut unsupported, mut collide) = (
+        Tally::default(),
+        Tally::default(),
+        Tally::default(),
+        Tally::default(),
+        Tally::default(),
+    );
     report.min_layer_height = f64::INFINITY;
     let mut running_max_z = f64::NEG_INFINITY;
-    let mut pending = 0usize; // next segment (pending → pending+1) to insert
+    let mut pending = 0usize; // next segment (pending → pending + 1) to insert
     let layer_tol = 0.01 * limits.max_layer_height + 0.002;
-    let angle_tol = 0.5;
+    // Degrees: G-code coordinates are rounded to 1 µm and the lean is measured against polyline
+    // segments; the seam step where the helix leaves the flat revolution leans up to ~2° more
+    // than the sections around it for one point.
+    let angle_tol = 2.0;
     for j in 0..v.len() {
         let p = v[j];
-        // Insert segments that ended far enough back along the path.
-        while pending + 1 < v.len() && cum[j] - cum[pending + 1] > gap {
+        // Every earlier segment is a candidate; the bead just laid is told apart below.
+        while pending + 1 <= j {
             grid.insert(pending as u32, v[pending], v[pending + 1]);
             pending += 1;
         }
@@ -385,16 +458,54 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
         }
         // The topmost earlier layer below p within the search radius.
         let pxy = p.truncate();
-        let (k_lo, k_hi) = (grid.key(pxy - radius, p.z - reach), grid.key(pxy + radius, p.z - below_tol));
+        let (k_lo, k_hi) = (
+            grid.key(pxy - radius, p.z - reach),
+            grid.key(pxy + radius, p.z - below_tol),
+        );
         let mut found: Vec<(f64, f64)> = Vec::new();
         for x in k_lo.0..=k_hi.0 {
             for y in k_lo.1..=k_hi.1 {
                 for z in k_lo.2..=k_hi.2 {
-                    let Some(ids) = grid.cells.get(&(x, y, z)) else { continue };
+                    let Some(ids) = grid.cells.get(&(x, y, z)) else {
+                        continue;
+                    };
                     for &id in ids {
                         let (a, b) = (v[id as usize], v[id as usize + 1]);
-                        let (d, f) = point_segment_distance(pxy, a.truncate(), b.truncate());
+                        // Distance across the segment's line, for feet of the perpendicular on
+                        // the segment or just past its ends; a segment entirely ahead of or
+                        // behind p along its own direction is beside p, not under it.
+                        let (a2, b2) = (a.truncate(), b.truncate());
+                        let ab = b2 - a2;
+                        let len2 = ab.length_squared();
+                        // A steep segment (rising more than it runs) is a step between layers,
+                        // not a layer to rest on.
+                        if (b.z - a.z).powi(2) > len2 {
+                            continue;
+                        }
+                        let f_line = if len2 > 0.0 {
+                            (pxy - a2).dot(ab) / len2
+                        } else {
+                            0.0
+                        };
+                        if !(-0.5..=1.5).contains(&f_line) {
+                            continue;
+                        }
+                        let (d_end, f) = point_segment_distance(pxy, a2, b2);
+                        let d = if len2 > 0.0 {
+                            ab.perp_dot(pxy - a2).abs() / len2.sqrt()
+                        } else {
+                            d_end
+                        };
                         let zq = a.z + (b.z - a.z) * f;
+                        // The bead just laid: reached from p along an almost straight stretch of
+                        // path. Where the path has come back over itself (the next revolution,
+                        // the centre of a spiral base) the layer below is much nearer in XY than
+                        // along the path.
+                        let along = cum[j]
+                            - (cum[id as usize] + f * (cum[id as usize + 1] - cum[id as usize]));
+                        if along < gap && d >= 0.5 * along {
+                            continue;
+                        }
                         if d <= radius && zq <= p.z - below_tol && zq >= p.z - reach {
                             found.push((zq, d));
                         }
@@ -404,9 +515,17 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
         }
         // Support: the topmost layer within half a bead of p; failing that, the nearest layer.
         let half_bead = 0.5 * limits.line_width;
-        let top_under = found.iter().filter(|(_, d)| *d <= half_bead).map(|(z, _)| *z).fold(f64::NEG_INFINITY, f64::max);
+        let top_under = found
+            .iter()
+            .filter(|(_, d)| *d <= half_bead)
+            .map(|(z, _)| *z)
+            .fold(f64::NEG_INFINITY, f64::max);
         let (height, offset) = if top_under.is_finite() {
-            let offset = found.iter().filter(|(z, _)| *z >= top_under - below_tol).map(|(_, d)| *d).fold(f64::INFINITY, f64::min);
+            let offset = found
+                .iter()
+                .filter(|(z, _)| *z >= top_under - below_tol)
+                .map(|(_, d)| *d)
+                .fold(f64::INFINITY, f64::min);
             (p.z - top_under, offset)
         } else if let Some(&(z, d)) = found.iter().min_by(|a, b| a.1.total_cmp(&b.1)) {
             (p.z - z, d)
@@ -435,14 +554,52 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
     }
     let mut push = |t: Tally, what: &'static str, detail: String| {
         if t.count > 0 {
-            report.violations.push(Violation { what, count: t.count, worst: t.worst, first_line: t.first_line, detail });
+            report.violations.push(Violation {
+                what,
+                count: t.count,
+                worst: t.worst,
+                first_line: t.first_line,
+                detail,
+            });
         }
     };
-    push(thin, "layer too thin", format!("below min_layer_height {} mm (worst = mm short)", limits.min_layer_height));
-    push(thick, "layer too thick", format!("above max_layer_height {} mm (worst = mm over)", limits.max_layer_height));
-    push(lean, "overhang", format!("wall leans past {}° (worst = degrees)", limits.max_overhang_deg));
-    push(unsupported, "unsupported", format!("no printed layer within {radius:.1} mm below (worst = z, mm)"));
-    push(collide, "nozzle collision", format!("printed part rises above the holder, nozzle_length {} mm (worst = mm)", limits.nozzle_length));
+    push(
+        thin,
+        "layer too thin",
+        format!(
+            "below min_layer_height {} mm (worst = mm short)",
+            limits.min_layer_height
+        ),
+    );
+    push(
+        thick,
+        "layer too thick",
+        format!(
+            "above max_layer_height {} mm (worst = mm over)",
+            limits.max_layer_height
+        ),
+    );
+    push(
+        lean,
+        "overhang",
+        format!(
+            "wall leans past {}° (worst = degrees)",
+            limits.max_overhang_deg
+        ),
+    );
+    push(
+        unsupported,
+        "unsupported",
+        format!("no printed layer within {radius:.1} mm below (worst = z, mm)"),
+    );
+    push(
+        collide,
+        "nozzle collision",
+        format!(
+            "printed part rises above the holder, nozzle_length {} mm (worst = mm)",
+            limits.nozzle_length
+        ),
+    );
 }
 
 #[cfg(test)]
@@ -468,7 +625,12 @@ mod tests {
             } else {
                 h * t
             };
-            s += &format!("G1 X{:.3} Y{:.3} Z{:.3} E0.5\n", 90.0 + r * a.cos(), 95.0 + r * a.sin(), z);
+            s += &format!(
+                "G1 X{:.3} Y{:.3} Z{:.3} E0.5\n",
+                90.0 + r * a.cos(),
+                95.0 + r * a.sin(),
+                z
+            );
         }
         s
     }
@@ -484,7 +646,11 @@ mod tests {
     #[test]
     fn flare_past_45_is_an_overhang() {
         let r = check_gcode(&helix(1.5, 10, 1.0), &limits()).unwrap();
-        let v = r.violations.iter().find(|v| v.what == "overhang").expect("overhang found");
+        let v = r
+            .violations
+            .iter()
+            .find(|v| v.what == "overhang")
+            .expect("overhang found");
         // 1.5 mm outward per 1 mm layer is 56°; steeper where the helix leaves the flat revolution.
         assert!(v.worst >= 56.0, "{}", v.worst);
         assert!(v.count > 500, "{}", v.count);

@@ -25,7 +25,12 @@ pub struct SurfaceMetrics {
 /// Clamps the normal offset of every point of sections `from ..` against the section below to
 /// `tan_limit·Δz`. Returns the points moved (or, with `enforce = false`, the points in violation,
 /// unchanged). Also returns the index of the highest section changed, if any.
-pub fn clamp_overhang(sections: &mut [Section], from: usize, tan_limit: f64, enforce: bool) -> Vec<PointEvent> {
+pub fn clamp_overhang(
+    sections: &mut [Section],
+    from: usize,
+    tan_limit: f64,
+    enforce: bool,
+) -> Vec<PointEvent> {
     let mut events = Vec::new();
     for k in from.max(1)..sections.len() {
         let (below, above) = sections.split_at_mut(k);
@@ -45,7 +50,11 @@ pub fn clamp_overhang(sections: &mut [Section], from: usize, tan_limit: f64, enf
                     p.x -= shift.x;
                     p.y -= shift.y;
                 }
-                events.push(PointEvent { layer: k, sample: i, amount_mm: excess });
+                events.push(PointEvent {
+                    layer: k,
+                    sample: i,
+                    amount_mm: excess,
+                });
             }
         }
     }
@@ -54,7 +63,10 @@ pub fn clamp_overhang(sections: &mut [Section], from: usize, tan_limit: f64, enf
 
 /// Largest lean, z ranges and layer heights of a surface.
 pub fn measure(sections: &[Section]) -> SurfaceMetrics {
-    let mut m = SurfaceMetrics { min_layer_height: f64::INFINITY, ..Default::default() };
+    let mut m = SurfaceMetrics {
+        min_layer_height: f64::INFINITY,
+        ..Default::default()
+    };
     for (k, s) in sections.iter().enumerate() {
         let (lo, hi) = s.z_range();
         if k > 0 {
@@ -96,7 +108,9 @@ mod tests {
     #[test]
     fn flare_past_45_degrees_is_clamped_to_45() {
         // Radius grows 2 mm per 1 mm layer: 63.4°. Clamped to 1 mm per layer.
-        let mut s: Vec<Section> = (0..5).map(|k| ring(30.0 + 2.0 * k as f64, k as f64, 360)).collect();
+        let mut s: Vec<Section> = (0..5)
+            .map(|k| ring(30.0 + 2.0 * k as f64, k as f64, 360))
+            .collect();
         let before = measure(&s);
         assert!((before.max_overhang_deg - 2f64.atan().to_degrees()).abs() < 0.1);
         let ev = clamp_overhang(&mut s, 1, 1.0, true);
@@ -104,14 +118,20 @@ mod tests {
         // First correction removes 1 mm; later ones more as the design runs away.
         assert!((ev[0].amount_mm - 1.0).abs() < 1e-3);
         let after = measure(&s);
-        assert!(after.max_overhang_deg <= 45.0 + 1e-6, "{}", after.max_overhang_deg);
+        assert!(
+            after.max_overhang_deg <= 45.0 + 1e-6,
+            "{}",
+            after.max_overhang_deg
+        );
         let r_top = s[4].points[0].truncate().length();
         assert!((r_top - 34.0).abs() < 1e-3, "{r_top}");
     }
 
     #[test]
     fn report_only_leaves_the_surface_alone() {
-        let mut s: Vec<Section> = (0..3).map(|k| ring(30.0 + 2.0 * k as f64, k as f64, 90)).collect();
+        let mut s: Vec<Section> = (0..3)
+            .map(|k| ring(30.0 + 2.0 * k as f64, k as f64, 90))
+            .collect();
         let copy = s.clone();
         let ev = clamp_overhang(&mut s, 1, 1.0, false);
         assert_eq!(ev.len(), 2 * 90);
@@ -123,6 +143,8 @@ mod tests {
         let s: Vec<Section> = (0..4).map(|k| ring(30.0, k as f64 * 0.5, 100)).collect();
         let m = measure(&s);
         assert!(m.max_overhang_deg < 1e-6);
-        assert!((m.min_layer_height - 0.5).abs() < 1e-12 && (m.max_layer_height - 0.5).abs() < 1e-12);
+        assert!(
+            (m.min_layer_height - 0.5).abs() < 1e-12 && (m.max_layer_height - 0.5).abs() < 1e-12
+        );
     }
 }

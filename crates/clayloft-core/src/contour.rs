@@ -45,20 +45,37 @@ impl Contour {
                     DVec2::new(rx * th.cos(), ry * th.sin())
                 })
                 .collect(),
-            ContourSpec::Rose { radius, amplitude, petals } => {
-                polar(dense, |th| radius + amplitude * (*petals as f64 * th).cos())
-            }
-            ContourSpec::Polygon { sides, radius, corner_radius } => {
-                rounded_polygon(*sides, *radius, *corner_radius, dense)
-            }
-            ContourSpec::Star { points, outer_radius, inner_radius } => (0..2 * points)
+            ContourSpec::Rose {
+                radius,
+                amplitude,
+                petals,
+            } => polar(dense, |th| radius + amplitude * (*petals as f64 * th).cos()),
+            ContourSpec::Polygon {
+                sides,
+                radius,
+                corner_radius,
+            } => rounded_polygon(*sides, *radius, *corner_radius, dense),
+            ContourSpec::Star {
+                points,
+                outer_radius,
+                inner_radius,
+            } => (0..2 * points)
                 .map(|j| {
-                    let r = if j % 2 == 0 { *outer_radius } else { *inner_radius };
+                    let r = if j % 2 == 0 {
+                        *outer_radius
+                    } else {
+                        *inner_radius
+                    };
                     DVec2::from_angle(PI * j as f64 / *points as f64) * r
                 })
                 .collect(),
             ContourSpec::Spline { points } => {
-                let ctrl = dedup_closed(&points.iter().map(|&[x, y]| DVec2::new(x, y)).collect::<Vec<_>>());
+                let ctrl = dedup_closed(
+                    &points
+                        .iter()
+                        .map(|&[x, y]| DVec2::new(x, y))
+                        .collect::<Vec<_>>(),
+                );
                 if ctrl.len() < 3 {
                     return Err(ContourError::TooFewPoints);
                 }
@@ -79,10 +96,18 @@ impl Contour {
             return Err(ContourError::TooFewPoints);
         }
         let area = signed_area(&points);
-        let scale = points.iter().map(|p| p.length_squared()).fold(0.0, f64::max);
-        let far = points.iter().copied().max_by(|a, b| a.distance_squared(points[0]).total_cmp(&b.distance_squared(points[0])));
+        let scale = points
+            .iter()
+            .map(|p| p.length_squared())
+            .fold(0.0, f64::max);
+        let far = points.iter().copied().max_by(|a, b| {
+            a.distance_squared(points[0])
+                .total_cmp(&b.distance_squared(points[0]))
+        });
         let dir = (far.unwrap_or(points[0]) - points[0]).normalize_or_zero();
-        let collinear = points.iter().all(|p| dir.perp_dot(*p - points[0]).abs() <= 1e-9 * scale.sqrt().max(1.0));
+        let collinear = points
+            .iter()
+            .all(|p| dir.perp_dot(*p - points[0]).abs() <= 1e-9 * scale.sqrt().max(1.0));
         let flat = collinear || area.abs() <= 1e-12 * scale.max(1e-9);
         if let Some((i, _)) = find_self_intersection(&points) {
             if collinear {
@@ -102,7 +127,9 @@ impl Contour {
 
     /// Translates every point by `offset`.
     pub fn translated(&self, offset: DVec2) -> Contour {
-        Contour { points: self.points.iter().map(|p| *p + offset).collect() }
+        Contour {
+            points: self.points.iter().map(|p| *p + offset).collect(),
+        }
     }
 }
 
@@ -157,14 +184,18 @@ mod tests {
 
     #[test]
     fn clockwise_spline_is_normalised_to_ccw() {
-        let cw = ContourSpec::Spline { points: vec![[40.0, 0.0], [0.0, -35.0], [-40.0, 0.0], [0.0, 35.0]] };
+        let cw = ContourSpec::Spline {
+            points: vec![[40.0, 0.0], [0.0, -35.0], [-40.0, 0.0], [0.0, 35.0]],
+        };
         let c = Contour::from_spec(&cw, 1024).unwrap();
         assert!(signed_area(&c.points) > 0.0);
     }
 
     #[test]
     fn self_intersecting_spline_is_rejected() {
-        let bow = ContourSpec::Spline { points: vec![[0.0, 0.0], [20.0, 20.0], [20.0, 0.0], [0.0, 20.0]] };
+        let bow = ContourSpec::Spline {
+            points: vec![[0.0, 0.0], [20.0, 20.0], [20.0, 0.0], [0.0, 20.0]],
+        };
         assert!(matches!(
             Contour::from_spec(&bow, 1024),
             Err(ContourError::SelfIntersecting { .. })
@@ -173,10 +204,17 @@ mod tests {
 
     #[test]
     fn collinear_and_repeated_points_are_rejected() {
-        let line = ContourSpec::Spline { points: vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]] };
+        let line = ContourSpec::Spline {
+            points: vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]],
+        };
         assert!(Contour::from_spec(&line, 64).is_err());
-        let same = ContourSpec::Spline { points: vec![[1.0, 1.0], [1.0, 1.0], [1.0, 1.0]] };
-        assert_eq!(Contour::from_spec(&same, 64), Err(ContourError::TooFewPoints));
+        let same = ContourSpec::Spline {
+            points: vec![[1.0, 1.0], [1.0, 1.0], [1.0, 1.0]],
+        };
+        assert_eq!(
+            Contour::from_spec(&same, 64),
+            Err(ContourError::TooFewPoints)
+        );
     }
 
     #[test]
@@ -185,24 +223,44 @@ mod tests {
         // straight edge and adds a full circle 2πr.
         let (r_circ, rc) = (40.0_f64, 5.0);
         let c = Contour::from_spec(
-            &ContourSpec::Polygon { sides: 4, radius: r_circ, corner_radius: rc },
+            &ContourSpec::Polygon {
+                sides: 4,
+                radius: r_circ,
+                corner_radius: rc,
+            },
             DENSE_POINTS,
         )
         .unwrap();
         let a = r_circ * 2f64.sqrt();
         let expected = 4.0 * a - 8.0 * rc + TAU * rc;
-        assert!((closed_length(&c.points) - expected).abs() < 0.01, "{}", closed_length(&c.points));
+        assert!(
+            (closed_length(&c.points) - expected).abs() < 0.01,
+            "{}",
+            closed_length(&c.points)
+        );
     }
 
     #[test]
     fn star_and_rose_extremes() {
         let s = Contour::from_spec(
-            &ContourSpec::Star { points: 5, outer_radius: 45.0, inner_radius: 30.0 },
+            &ContourSpec::Star {
+                points: 5,
+                outer_radius: 45.0,
+                inner_radius: 30.0,
+            },
             DENSE_POINTS,
         )
         .unwrap();
         assert_eq!(s.points.len(), 10);
-        let r = Contour::from_spec(&ContourSpec::Rose { radius: 45.0, amplitude: 8.0, petals: 6 }, DENSE_POINTS).unwrap();
+        let r = Contour::from_spec(
+            &ContourSpec::Rose {
+                radius: 45.0,
+                amplitude: 8.0,
+                petals: 6,
+            },
+            DENSE_POINTS,
+        )
+        .unwrap();
         let max = r.points.iter().map(|p| p.length()).fold(0.0, f64::max);
         let min = r.points.iter().map(|p| p.length()).fold(f64::MAX, f64::min);
         assert!((max - 53.0).abs() < 1e-9 && (min - 37.0).abs() < 1e-3);

@@ -38,7 +38,10 @@ impl VerticalProfile {
         VerticalProfile {
             profile: Pchip::new(xs, ys),
             local: line.angle.map(|a| {
-                (a.to_radians(), line.width.unwrap_or(DEFAULT_LOCAL_WIDTH_DEG).to_radians())
+                (
+                    a.to_radians(),
+                    line.width.unwrap_or(DEFAULT_LOCAL_WIDTH_DEG).to_radians(),
+                )
             }),
             span,
         }
@@ -82,7 +85,11 @@ impl HorizontalProfile {
     pub fn new(line: &HorizontalLine) -> HorizontalProfile {
         let xs: Vec<f64> = line.points.iter().map(|p| p[0]).collect();
         let ys: Vec<f64> = line.points.iter().map(|p| p[1]).collect();
-        HorizontalProfile { dz: Pchip::periodic(&xs, &ys, 360.0), at: line.at, reach: line.reach }
+        HorizontalProfile {
+            dz: Pchip::periodic(&xs, &ys, 360.0),
+            at: line.at,
+            reach: line.reach,
+        }
     }
 
     /// z offset (mm) at angle `phi` (radians) at full weight.
@@ -93,14 +100,22 @@ impl HorizontalProfile {
     /// Weight at height fraction `t`.
     pub fn weight_at(&self, t: f64) -> f64 {
         let s = (t - self.at).abs() / self.reach;
-        if s >= 1.0 { 0.0 } else { 0.5 * (1.0 + (std::f64::consts::PI * s).cos()) }
+        if s >= 1.0 {
+            0.0
+        } else {
+            0.5 * (1.0 + (std::f64::consts::PI * s).cos())
+        }
     }
 }
 
 /// Signed difference `a − b` of two angles (radians), in (−π, π].
 pub fn angle_difference(a: f64, b: f64) -> f64 {
     let d = (a - b).rem_euclid(std::f64::consts::TAU);
-    if d > std::f64::consts::PI { d - std::f64::consts::TAU } else { d }
+    if d > std::f64::consts::PI {
+        d - std::f64::consts::TAU
+    } else {
+        d
+    }
 }
 
 #[cfg(test)]
@@ -109,7 +124,11 @@ mod tests {
 
     #[test]
     fn global_belly_profile() {
-        let v = VerticalProfile::new(&VerticalLine { points: vec![[0.0, 0.0], [0.5, 15.0], [1.0, 0.0]], angle: None, width: None });
+        let v = VerticalProfile::new(&VerticalLine {
+            points: vec![[0.0, 0.0], [0.5, 15.0], [1.0, 0.0]],
+            angle: None,
+            width: None,
+        });
         assert_eq!(v.offset_at(0.5), 15.0);
         assert_eq!(v.offset_at(0.0), 0.0);
         assert_eq!(v.weight_at(2.0), 1.0);

@@ -35,7 +35,10 @@ fn clearance_heights(design: &Design, tp: &Toolpath) -> (f64, f64) {
     let first = tp.points.first().map_or(0.0, |p| p.pos.z);
     let last = tp.points.last().map_or(0.0, |p| p.pos.z);
     let max_z = design.printer.max_z;
-    ((first + CLEARANCE).min(max_z), (last + CLEARANCE).min(max_z))
+    (
+        (first + CLEARANCE).min(max_z),
+        (last + CLEARANCE).min(max_z),
+    )
 }
 
 /// Extruded volume of the segment ending at point `i` (i ≥ 1), mm³.
@@ -51,10 +54,14 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
     let tp = &job.toolpath;
     let (z_in, z_out) = clearance_heights(design, tp);
     let travel = match (tp.points.first(), tp.points.last()) {
-        (Some(f), Some(l)) => (z_in - f.pos.z).abs() * 2.0 + f.pos.truncate().length() + (z_out - l.pos.z).abs(),
+        (Some(f), Some(l)) => {
+            (z_in - f.pos.z).abs() * 2.0 + f.pos.truncate().length() + (z_out - l.pos.z).abs()
+        }
         _ => 0.0,
     };
-    let volume = (1..tp.points.len()).map(|i| segment_volume(design, tp, i)).sum();
+    let volume = (1..tp.points.len())
+        .map(|i| segment_volume(design, tp, i))
+        .sum();
     JobSummary {
         layers: job.surface.layers,
         points: tp.points.len(),
@@ -68,7 +75,11 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
 pub fn format_duration(seconds: f64) -> String {
     let s = seconds.max(0.0).round() as u64;
     let (h, m, s) = (s / 3600, (s / 60) % 60, s % 60);
-    if h > 0 { format!("{h}h {m:02}m {s:02}s") } else { format!("{m}m {s:02}s") }
+    if h > 0 {
+        format!("{h}h {m:02}m {s:02}s")
+    } else {
+        format!("{m}m {s:02}s")
+    }
 }
 
 /// Writes the whole G-code program of a job.
@@ -78,7 +89,11 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
     let summary = summarize(design, job);
     let mut head = String::new();
     use std::fmt::Write as _;
-    let _ = writeln!(head, "; Clayloft {} — one continuous spiral for clay paste extrusion", env!("CARGO_PKG_VERSION"));
+    let _ = writeln!(
+        head,
+        "; Clayloft {} — one continuous spiral for clay paste extrusion",
+        env!("CARGO_PKG_VERSION")
+    );
     let _ = writeln!(head, "; design: {}", design.name.replace(['\n', '\r'], " "));
     let _ = writeln!(
         head,
@@ -89,7 +104,12 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
         summary.path_length_mm,
         summary.volume_mm3 / 1000.0
     );
-    let _ = writeln!(head, "; estimated time: {} ({:.0} s)", format_duration(summary.estimated_time_s), summary.estimated_time_s);
+    let _ = writeln!(
+        head,
+        "; estimated time: {} ({:.0} s)",
+        format_duration(summary.estimated_time_s),
+        summary.estimated_time_s
+    );
     let _ = writeln!(
         head,
         "; settings: nozzle {} mm, line width {} mm, layer height {} mm ({} .. {}), speed {} mm/s, feed diameter {} mm, flow x{}, {} E, min layer time {} s",
@@ -110,7 +130,14 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
     let _ = writeln!(
         head,
         "{LIMITS_KEY} bed_x={} bed_y={} max_z={} line_width={} min_layer_height={} max_layer_height={} nozzle_length={} max_overhang_deg={}",
-        p.bed_x, p.bed_y, p.max_z, p.line_width, p.min_layer_height, p.max_layer_height, p.nozzle_length, p.max_overhang_deg
+        p.bed_x,
+        p.bed_y,
+        p.max_z,
+        p.line_width,
+        p.min_layer_height,
+        p.max_layer_height,
+        p.nozzle_length,
+        p.max_overhang_deg
     );
     for f in &job.surface.findings {
         let _ = writeln!(head, "; {f}");
@@ -269,9 +296,18 @@ mod tests {
         // Wall segment in the steady helix: E = w·h·len / (π·3²/4), len = chord of a 30 mm circle in 60 steps.
         let chord = 2.0 * 30.0 * (std::f64::consts::PI / 60.0).sin();
         let e_expected = 3.0 * 1.0 * chord / (std::f64::consts::PI * 9.0 / 4.0);
-        let line = text.lines().filter(|l| l.starts_with("G1")).nth(300).unwrap();
-        let e: f64 = line.split(' ').find(|w| w.starts_with('E')).unwrap()[1..].parse().unwrap();
-        assert!((e - e_expected).abs() < 2e-3 * e_expected, "{e} vs {e_expected}: {line}");
+        let line = text
+            .lines()
+            .filter(|l| l.starts_with("G1"))
+            .nth(300)
+            .unwrap();
+        let e: f64 = line.split(' ').find(|w| w.starts_with('E')).unwrap()[1..]
+            .parse()
+            .unwrap();
+        assert!(
+            (e - e_expected).abs() < 2e-3 * e_expected,
+            "{e} vs {e_expected}: {line}"
+        );
         assert!(text.contains("M83"));
         assert!(text.contains("; estimated time:"));
         assert!(text.contains(LIMITS_KEY));
@@ -284,7 +320,11 @@ mod tests {
         let rel: f64 = gcode(&d, &j)
             .lines()
             .filter(|l| l.starts_with("G1"))
-            .map(|l| l.split(' ').find(|w| w.starts_with('E')).unwrap()[1..].parse::<f64>().unwrap())
+            .map(|l| {
+                l.split(' ').find(|w| w.starts_with('E')).unwrap()[1..]
+                    .parse::<f64>()
+                    .unwrap()
+            })
             .sum();
         let abs_text = gcode(&da, &ja);
         assert!(abs_text.contains("M82"));
@@ -292,7 +332,11 @@ mod tests {
             .lines()
             .filter(|l| l.starts_with("G1"))
             .last()
-            .map(|l| l.split(' ').find(|w| w.starts_with('E')).unwrap()[1..].parse().unwrap())
+            .map(|l| {
+                l.split(' ').find(|w| w.starts_with('E')).unwrap()[1..]
+                    .parse()
+                    .unwrap()
+            })
             .unwrap();
         assert!((rel - last_e).abs() < 1e-3 * rel, "{rel} {last_e}");
     }
@@ -301,7 +345,8 @@ mod tests {
     fn output_is_deterministic_and_textured_prints_longer() {
         let (d, j) = job("");
         assert_eq!(gcode(&d, &j), gcode(&d, &crate::pipeline::run(&d).unwrap()));
-        let (dt, jt) = job("[texture]\n[texture.x]\nwave = \"sine\"\nperiod = 6\namplitude = 1.0\n");
+        let (dt, jt) =
+            job("[texture]\n[texture.x]\nwave = \"sine\"\nperiod = 6\namplitude = 1.0\n");
         assert!(summarize(&dt, &jt).estimated_time_s > summarize(&d, &j).estimated_time_s);
     }
 }

@@ -23,7 +23,9 @@ pub fn signed_area(points: &[DVec2]) -> f64 {
 /// Total length of a closed polyline (including the closing segment).
 pub fn closed_length(points: &[DVec2]) -> f64 {
     let n = points.len();
-    (0..n).map(|i| points[i].distance(points[(i + 1) % n])).sum()
+    (0..n)
+        .map(|i| points[i].distance(points[(i + 1) % n]))
+        .sum()
 }
 
 /// Cumulative arc length at each vertex of a closed polyline: `s[0] = 0`, `s[i] = Σ_{j<i} |p_{j+1} − p_j|`.
@@ -55,7 +57,11 @@ pub fn resample_closed(points: &[DVec2], count: usize) -> Vec<DVec2> {
             seg += 1;
         }
         let len = s[seg + 1] - s[seg];
-        let f = if len > 0.0 { (target - s[seg]) / len } else { 0.0 };
+        let f = if len > 0.0 {
+            (target - s[seg]) / len
+        } else {
+            0.0
+        };
         out.push(points[seg].lerp(points[(seg + 1) % n], f));
     }
     out
@@ -227,13 +233,7 @@ mod tests {
 
     #[test]
     fn dedup_drops_repeats_and_closing_point() {
-        let pts = [
-            DVec2::ZERO,
-            DVec2::ZERO,
-            DVec2::X,
-            DVec2::ONE,
-            DVec2::ZERO,
-        ];
+        let pts = [DVec2::ZERO, DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::ZERO];
         assert_eq!(dedup_closed(&pts).len(), 3);
     }
 }

@@ -16,7 +16,11 @@ pub enum DesignError {
     #[error("{file}: cannot read the design: {reason}")]
     Read { file: String, reason: String },
     #[error("{file}:{line}: {message}")]
-    Syntax { file: String, line: usize, message: String },
+    Syntax {
+        file: String,
+        line: usize,
+        message: String,
+    },
     #[error("{file}{}: {field}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Field {
         file: String,
@@ -45,7 +49,10 @@ impl LoadedDesign {
 /// Reads, parses and validates a design file.
 pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
     let file = path.display().to_string();
-    let read_err = |reason: String| DesignError::Read { file: file.clone(), reason };
+    let read_err = |reason: String| DesignError::Read {
+        file: file.clone(),
+        reason,
+    };
     let meta = std::fs::metadata(path).map_err(|e| read_err(io_reason(&e)))?;
     if meta.is_dir() {
         return Err(read_err("it is a folder, not a file".into()));
@@ -60,10 +67,18 @@ pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
     let source = String::from_utf8(bytes)
         .map_err(|_| read_err("it is not a text (UTF-8) file — is it a design?".into()))?;
     let design = parse_design(&source).map_err(|e| match e {
-        ParseError::Syntax { line, message } => DesignError::Syntax { file: file.clone(), line, message },
+        ParseError::Syntax { line, message } => DesignError::Syntax {
+            file: file.clone(),
+            line,
+            message,
+        },
         ParseError::Field(f) => located(path, &source, f),
     })?;
-    Ok(LoadedDesign { design, path: path.to_path_buf(), source })
+    Ok(LoadedDesign {
+        design,
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// A problem in design text, before a file name is attached.
@@ -77,7 +92,10 @@ pub enum ParseError {
 pub fn parse_design(source: &str) -> Result<Design, ParseError> {
     let design: Design = toml::from_str(source).map_err(|e| {
         let line = e.span().map(|s| line_of(source, s.start)).unwrap_or(1);
-        ParseError::Syntax { line, message: first_line(e.message()) }
+        ParseError::Syntax {
+            line,
+            message: first_line(e.message()),
+        }
     })?;
     validate(&design).map_err(ParseError::Field)?;
     Ok(design)
@@ -161,16 +179,29 @@ fn field_offset(source: &str, field: &str) -> Option<usize> {
 }
 
 /// Continues [`field_offset`] inside one table of an array of tables.
-fn descend_table(t: &toml_edit::Table, field: &str, part: &str, best: Option<usize>) -> Option<usize> {
-    let rest = field.split_once(part).map(|(_, r)| r.trim_start_matches('.')).unwrap_or("");
+fn descend_table(
+    t: &toml_edit::Table,
+    field: &str,
+    part: &str,
+    best: Option<usize>,
+) -> Option<usize> {
+    let rest = field
+        .split_once(part)
+        .map(|(_, r)| r.trim_start_matches('.'))
+        .unwrap_or("");
     if rest.is_empty() {
         return best;
     }
     let (key, idx) = match rest.split_once('[') {
-        Some((k, i)) => (k.split('.').next().unwrap_or(k), i.trim_end_matches(']').parse::<usize>().ok()),
+        Some((k, i)) => (
+            k.split('.').next().unwrap_or(k),
+            i.trim_end_matches(']').parse::<usize>().ok(),
+        ),
         None => (rest.split('.').next().unwrap_or(rest), None),
     };
-    let Some((k, v)) = t.get_key_value(key) else { return best };
+    let Some((k, v)) = t.get_key_value(key) else {
+        return best;
+    };
     let here = k.span().map(|s| s.start).or(best);
     match (v, idx) {
         (toml_edit::Item::Value(toml_edit::Value::Array(a)), Some(i)) => {
@@ -245,7 +276,10 @@ mod tests {
     #[test]
     fn samples_bounds() {
         for s in ["2", "100000000"] {
-            let src = MINIMAL.replace("version = 1\n", &format!("version = 1\n[shape]\nsamples = {s}\n"));
+            let src = MINIMAL.replace(
+                "version = 1\n",
+                &format!("version = 1\n[shape]\nsamples = {s}\n"),
+            );
             match err_of(&src) {
                 ParseError::Field(f) => assert_eq!(f.field, "shape.samples"),
                 e => panic!("{e:?}"),
@@ -255,9 +289,15 @@ mod tests {
 
     #[test]
     fn image_contour_is_not_supported_yet() {
-        let src = MINIMAL.replace("type = \"circle\"\nradius = 40.0", "type = \"image\"\npath = \"leaf.png\"\nsize = 80.0");
+        let src = MINIMAL.replace(
+            "type = \"circle\"\nradius = 40.0",
+            "type = \"image\"\npath = \"leaf.png\"\nsize = 80.0",
+        );
         let e = load_str(&src).to_string();
-        assert!(e.contains("shape.lower.type") && e.contains("not supported yet"), "{e}");
+        assert!(
+            e.contains("shape.lower.type") && e.contains("not supported yet"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -279,7 +319,11 @@ mod tests {
         match parse_design(src) {
             Ok(_) => panic!("should fail"),
             Err(ParseError::Field(f)) => located(Path::new("t.toml"), src, f),
-            Err(ParseError::Syntax { line, message }) => DesignError::Syntax { file: "t.toml".into(), line, message },
+            Err(ParseError::Syntax { line, message }) => DesignError::Syntax {
+                file: "t.toml".into(),
+                line,
+                message,
+            },
         }
     }
 }

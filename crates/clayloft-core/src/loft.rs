@@ -24,7 +24,12 @@ pub struct LoftInput {
 }
 
 /// Builds, aligns and samples one contour of the design.
-pub fn sampled_contour(spec: &ContourSpec, field: &str, center: DVec2, samples: usize) -> Result<Vec<DVec2>, FieldError> {
+pub fn sampled_contour(
+    spec: &ContourSpec,
+    field: &str,
+    center: DVec2,
+    samples: usize,
+) -> Result<Vec<DVec2>, FieldError> {
     let contour = Contour::from_spec(spec, DENSE_POINTS.max(4 * samples))
         .map_err(|e: ContourError| FieldError::new(field, e.to_string()))?;
     let aligned = align(&contour, center);
@@ -50,7 +55,12 @@ impl LoftInput {
             .zip(&upper)
             .map(|(a, b)| ((*a + *b) * 0.5 - center).to_angle())
             .collect();
-        LoftInput { lower, upper, center, angles }
+        LoftInput {
+            lower,
+            upper,
+            center,
+            angles,
+        }
     }
 
     pub fn samples(&self) -> usize {

@@ -68,18 +68,31 @@ pub fn build_surface(design: &Design) -> Result<Surface, FieldError> {
             let columns = events.len();
             let mut f = group_events(&events, FindingKind::Texture, enforce, usize::MAX, |mm| {
                 if enforce {
-                    format!("texture amplitude lowered by up to {mm:.2} mm on {columns} of the columns to keep the overhang limit")
+                    format!(
+                        "texture amplitude lowered by up to {mm:.2} mm on {columns} of the columns to keep the overhang limit"
+                    )
                 } else {
-                    format!("texture breaks the overhang limit on {columns} columns (up to {mm:.2} mm too deep)")
+                    format!(
+                        "texture breaks the overhang limit on {columns} columns (up to {mm:.2} mm too deep)"
+                    )
                 }
             });
             findings.append(&mut f);
         }
         // Safety net: whatever the column scaling missed (normals turn with the texture).
-        let residual = clamp_overhang(&mut sections, 1, overhang_tan_limit(design) / LIMIT_MARGIN, enforce);
-        findings.extend(group_events(&residual, FindingKind::Texture, enforce, 3, |mm| {
-            format!("textured wall clamped by up to {mm:.2} mm at the overhang limit")
-        }));
+        let residual = clamp_overhang(
+            &mut sections,
+            1,
+            overhang_tan_limit(design) / LIMIT_MARGIN,
+            enforce,
+        );
+        findings.extend(group_events(
+            &residual,
+            FindingKind::Texture,
+            enforce,
+            3,
+            |mm| format!("textured wall clamped by up to {mm:.2} mm at the overhang limit"),
+        ));
     }
     let metrics = measure(&sections);
     let surface = Surface {
@@ -108,7 +121,11 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
         }
     }
     let (lo, hi) = (lo - half, hi + half);
-    let field = if design.shape.center.is_some() { "shape.center" } else { "shape" };
+    let field = if design.shape.center.is_some() {
+        "shape.center"
+    } else {
+        "shape"
+    };
     if lo.x < 0.0 || hi.x > p.bed_x {
         return Err(FieldError::new(
             field,
@@ -130,7 +147,10 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
     if top > p.max_z {
         return Err(FieldError::new(
             "shape.height",
-            format!("the rim reaches z = {top:.1} mm, above the build height printer.max_z = {} mm", p.max_z),
+            format!(
+                "the rim reaches z = {top:.1} mm, above the build height printer.max_z = {} mm",
+                p.max_z
+            ),
         ));
     }
     Ok(())

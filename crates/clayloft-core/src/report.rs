@@ -31,7 +31,11 @@ pub struct Finding {
 
 impl fmt::Display for Finding {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let verb = if self.corrected { "corrected" } else { "VIOLATION" };
+        let verb = if self.corrected {
+            "corrected"
+        } else {
+            "VIOLATION"
+        };
         write!(
             f,
             "{verb}: layers {}–{}, {} points, up to {:.2} mm: {}",
@@ -62,7 +66,7 @@ pub fn group_events(
     let mut out: Vec<Finding> = Vec::new();
     for e in sorted {
         match out.last_mut() {
-            Some(f) if e.layer <= f.layers.1 + gap => {
+            Some(f) if e.layer <= f.layers.1.saturating_add(gap) => {
                 f.layers.1 = f.layers.1.max(e.layer);
                 f.points += 1;
                 f.amount_mm = f.amount_mm.max(e.amount_mm);
@@ -89,7 +93,11 @@ mod tests {
 
     #[test]
     fn events_group_into_layer_runs() {
-        let ev = |layer, amount_mm| PointEvent { layer, sample: 0, amount_mm };
+        let ev = |layer, amount_mm| PointEvent {
+            layer,
+            sample: 0,
+            amount_mm,
+        };
         let f = group_events(
             &[ev(3, 0.5), ev(4, 1.5), ev(5, 0.2), ev(40, 0.1)],
             FindingKind::Overhang,
@@ -100,6 +108,9 @@ mod tests {
         assert_eq!(f.len(), 2);
         assert_eq!((f[0].layers, f[0].points, f[0].amount_mm), ((3, 5), 3, 1.5));
         assert_eq!(f[1].layers, (40, 40));
-        assert!(f[0].to_string().starts_with("corrected: layers 3–5, 3 points"));
+        assert!(
+            f[0].to_string()
+                .starts_with("corrected: layers 3–5, 3 points")
+        );
     }
 }

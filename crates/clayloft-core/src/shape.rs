@@ -41,8 +41,18 @@ pub struct ShapeModel {
 impl ShapeModel {
     /// Builds the model and plans the layers; returns findings for any horizontal-line scaling.
     pub fn new(design: &Design, loft: LoftInput) -> (ShapeModel, Vec<Finding>) {
-        let vertical: Vec<_> = design.control.vertical.iter().map(VerticalProfile::new).collect();
-        let horizontal: Vec<_> = design.control.horizontal.iter().map(HorizontalProfile::new).collect();
+        let vertical: Vec<_> = design
+            .control
+            .vertical
+            .iter()
+            .map(VerticalProfile::new)
+            .collect();
+        let horizontal: Vec<_> = design
+            .control
+            .horizontal
+            .iter()
+            .map(HorizontalProfile::new)
+            .collect();
         let hz = horizontal
             .iter()
             .map(|h| loft.angles.iter().map(|&phi| h.dz_at(phi)).collect())
@@ -86,7 +96,11 @@ impl ShapeModel {
             .map(|v| (v, v.offset_at(t)))
             .filter(|(_, d)| *d != 0.0)
             .collect();
-        let normals = if active.is_empty() { Vec::new() } else { outward_normals(&xy) };
+        let normals = if active.is_empty() {
+            Vec::new()
+        } else {
+            outward_normals(&xy)
+        };
         let z0 = k as f64 * self.layer_pitch;
         let points = (0..n)
             .map(|i| {
@@ -129,16 +143,23 @@ impl ShapeModel {
                 nominal
             }
         };
-        let thin_ok = |s: f64| s * g_min >= 0.0 || (height + s * g_min) / layers_for(s) as f64 >= hmin;
+        let thin_ok =
+            |s: f64| s * g_min >= 0.0 || (height + s * g_min) / layers_for(s) as f64 >= hmin;
         let holder_ok = |s: f64| self.holder_clearance(s, height) <= p.nozzle_length * LIMIT_MARGIN;
         let ok = |s: f64| thin_ok(s) && holder_ok(s);
         let mut findings = Vec::new();
         let mut s = 1.0;
         if !self.horizontal.is_empty() && !ok(1.0) {
             let why = if !holder_ok(1.0) {
-                format!("the z range of a layer would exceed the nozzle length ({} mm)", p.nozzle_length)
+                format!(
+                    "the z range of a layer would exceed the nozzle length ({} mm)",
+                    p.nozzle_length
+                )
             } else {
-                format!("layers would get thinner than min_layer_height ({} mm)", p.min_layer_height)
+                format!(
+                    "layers would get thinner than min_layer_height ({} mm)",
+                    p.min_layer_height
+                )
             };
             if design.constraints.enforce {
                 let (mut lo, mut hi) = (0.0, 1.0);
@@ -153,7 +174,10 @@ impl ShapeModel {
                     layers: (0, layers_for(s)),
                     points: self.loft.samples(),
                     amount_mm: self.max_abs_dz() * (1.0 - s),
-                    message: format!("horizontal control lines scaled to {:.0} %: {why}", s * 100.0),
+                    message: format!(
+                        "horizontal control lines scaled to {:.0} %: {why}",
+                        s * 100.0
+                    ),
                 });
             } else {
                 findings.push(Finding {
@@ -173,7 +197,10 @@ impl ShapeModel {
     }
 
     fn max_abs_dz(&self) -> f64 {
-        self.hz.iter().flatten().fold(0.0, |m: f64, v| m.max(v.abs()))
+        self.hz
+            .iter()
+            .flatten()
+            .fold(0.0, |m: f64, v| m.max(v.abs()))
     }
 
     /// Range of ∂dz/∂t over the height and all samples, at scale 1.
@@ -186,7 +213,11 @@ impl ShapeModel {
         let dt = 1.0 / PLAN_STEPS as f64;
         for step in 0..PLAN_STEPS {
             let (t0, t1) = (step as f64 * dt, (step + 1) as f64 * dt);
-            let dw: Vec<f64> = self.horizontal.iter().map(|h| (h.weight_at(t1) - h.weight_at(t0)) / dt).collect();
+            let dw: Vec<f64> = self
+                .horizontal
+                .iter()
+                .map(|h| (h.weight_at(t1) - h.weight_at(t0)) / dt)
+                .collect();
             if dw.iter().all(|w| *w == 0.0) {
                 continue;
             }

@@ -34,7 +34,9 @@ fn span_point(p0: DVec2, p1: DVec2, p2: DVec2, p3: DVec2, u: f64) -> DVec2 {
     let t2 = t1 + knot(p1, p2);
     let t3 = t2 + knot(p2, p3);
     let t = t1 + (t2 - t1) * u;
-    let lerp = |a: DVec2, b: DVec2, ta: f64, tb: f64| a * ((tb - t) / (tb - ta)) + b * ((t - ta) / (tb - ta));
+    let lerp = |a: DVec2, b: DVec2, ta: f64, tb: f64| {
+        a * ((tb - t) / (tb - ta)) + b * ((t - ta) / (tb - ta))
+    };
     let a1 = lerp(p0, p1, t0, t1);
     let a2 = lerp(p1, p2, t1, t2);
     let a3 = lerp(p2, p3, t2, t3);

@@ -28,7 +28,11 @@ pub fn wall_mesh(surface: &Surface, line_width: f64, base_layers: usize) -> Mesh
         let s = &sections[k];
         for (p, nrm) in s.points.iter().zip(s.normals()) {
             let z = if k == 0 { 0.0 } else { p.z };
-            m.vertices.push(DVec3::new(p.x + sign * half * nrm.x, p.y + sign * half * nrm.y, z));
+            m.vertices.push(DVec3::new(
+                p.x + sign * half * nrm.x,
+                p.y + sign * half * nrm.y,
+                z,
+            ));
         }
         start
     };
@@ -43,25 +47,49 @@ pub fn wall_mesh(surface: &Surface, line_width: f64, base_layers: usize) -> Mesh
     for k in 0..layers {
         for i in 0..n {
             let (o0, o1) = (outer[k], outer[k + 1]);
-            quad(&mut m, idx(o0, i), idx(o0, i + 1), idx(o1, i + 1), idx(o1, i));
+            quad(
+                &mut m,
+                idx(o0, i),
+                idx(o0, i + 1),
+                idx(o1, i + 1),
+                idx(o1, i),
+            );
         }
     }
     for k in 0..inner.len() - 1 {
         for i in 0..n {
             let (i0, i1) = (inner[k], inner[k + 1]);
-            quad(&mut m, idx(i0, i), idx(i1, i), idx(i1, i + 1), idx(i0, i + 1));
+            quad(
+                &mut m,
+                idx(i0, i),
+                idx(i1, i),
+                idx(i1, i + 1),
+                idx(i0, i + 1),
+            );
         }
     }
     // Rim, facing up.
     let (ot, it) = (outer[layers], inner[inner.len() - 1]);
     for i in 0..n {
-        quad(&mut m, idx(ot, i), idx(ot, i + 1), idx(it, i + 1), idx(it, i));
+        quad(
+            &mut m,
+            idx(ot, i),
+            idx(ot, i + 1),
+            idx(it, i + 1),
+            idx(it, i),
+        );
     }
     if base == 0 {
         // Open bottom: annulus on the bed, facing down.
         let (ob, ib) = (outer[0], inner[0]);
         for i in 0..n {
-            quad(&mut m, idx(ob, i), idx(ib, i), idx(ib, i + 1), idx(ob, i + 1));
+            quad(
+                &mut m,
+                idx(ob, i),
+                idx(ib, i),
+                idx(ib, i + 1),
+                idx(ob, i + 1),
+            );
         }
     } else {
         let c = surface.center;
@@ -71,8 +99,10 @@ pub fn wall_mesh(surface: &Surface, line_width: f64, base_layers: usize) -> Mesh
         let base_top_z = sections[base].points.iter().map(|p| p.z).sum::<f64>() / n as f64;
         m.vertices.push(DVec3::new(c.x, c.y, base_top_z));
         for i in 0..n {
-            m.triangles.push([bottom, idx(outer[0], i + 1), idx(outer[0], i)]);
-            m.triangles.push([top, idx(inner[0], i), idx(inner[0], i + 1)]);
+            m.triangles
+                .push([bottom, idx(outer[0], i + 1), idx(outer[0], i)]);
+            m.triangles
+                .push([top, idx(inner[0], i), idx(inner[0], i + 1)]);
         }
     }
     m
@@ -115,7 +145,10 @@ pub fn write_binary_stl(mesh: &Mesh, name: &str, out: &mut dyn Write) -> io::Res
 
 /// ASCII STL.
 pub fn write_ascii_stl(mesh: &Mesh, name: &str, out: &mut dyn Write) -> io::Result<()> {
-    let name: String = name.chars().filter(|c| c.is_ascii_graphic() || *c == ' ').collect();
+    let name: String = name
+        .chars()
+        .filter(|c| c.is_ascii_graphic() || *c == ' ')
+        .collect();
     writeln!(out, "solid {name}")?;
     for t in &mesh.triangles {
         let n = facet_normal(mesh, t);
@@ -145,7 +178,10 @@ pub(crate) mod tests {
             }
         }
         for (&(a, b), &count) in &directed {
-            assert_eq!(count, 1, "edge {a}->{b} used {count} times in one direction");
+            assert_eq!(
+                count, 1,
+                "edge {a}->{b} used {count} times in one direction"
+            );
             assert_eq!(directed.get(&(b, a)), Some(&1), "edge {a}-{b} has no twin");
         }
     }
@@ -177,7 +213,11 @@ pub(crate) mod tests {
         assert_closed_manifold(&m);
         // Tube of radii 28.5 and 31.5, 10 mm tall: π(31.5² − 28.5²)·10.
         let expected = std::f64::consts::PI * (31.5f64.powi(2) - 28.5f64.powi(2)) * 10.0;
-        assert!((volume(&m) - expected).abs() / expected < 1e-3, "{}", volume(&m));
+        assert!(
+            (volume(&m) - expected).abs() / expected < 1e-3,
+            "{}",
+            volume(&m)
+        );
     }
 
     #[test]
@@ -187,7 +227,11 @@ pub(crate) mod tests {
         assert_closed_manifold(&m);
         let expected = std::f64::consts::PI * (31.5f64.powi(2) - 28.5f64.powi(2)) * 8.0
             + std::f64::consts::PI * 31.5f64.powi(2) * 2.0;
-        assert!((volume(&m) - expected).abs() / expected < 2e-3, "{}", volume(&m));
+        assert!(
+            (volume(&m) - expected).abs() / expected < 2e-3,
+            "{}",
+            volume(&m)
+        );
     }
 
     #[test]

@@ -53,7 +53,11 @@ mod tests {
     use super::*;
 
     fn w(wave: WaveKind, period: f64, amplitude: f64) -> Wave {
-        Wave { wave, period, amplitude }
+        Wave {
+            wave,
+            period,
+            amplitude,
+        }
     }
 
     #[test]
@@ -73,13 +77,19 @@ mod tests {
             assert!((wave_value(&t, x as f64) - e).abs() < 1e-12, "x={x}");
         }
         let y = w(WaveKind::Triangle, 2.0, 2.0);
-        assert_eq!([0.0, 1.0, 2.0, 3.0].map(|k| wave_value(&y, k)), [2.0, -2.0, 2.0, -2.0]);
+        assert_eq!(
+            [0.0, 1.0, 2.0, 3.0].map(|k| wave_value(&y, k)),
+            [2.0, -2.0, 2.0, -2.0]
+        );
     }
 
     #[test]
     fn square_known_values() {
         let q = w(WaveKind::Square, 4.0, 1.5);
-        assert_eq!([0.0, 1.0, 2.0, 3.0, 4.0, 5.0].map(|x| wave_value(&q, x)), [0.0, 1.5, 0.0, -1.5, 0.0, 1.5]);
+        assert_eq!(
+            [0.0, 1.0, 2.0, 3.0, 4.0, 5.0].map(|x| wave_value(&q, x)),
+            [0.0, 1.5, 0.0, -1.5, 0.0, 1.5]
+        );
     }
 
     #[test]
@@ -160,7 +170,11 @@ pub fn apply_texture(
     for (i, &(s, k)) in scale.iter().enumerate() {
         if s < 1.0 - 1e-9 {
             let amp = disp.iter().map(|d| d[i].abs()).fold(0.0, f64::max);
-            events.push(crate::report::PointEvent { layer: k, sample: i, amount_mm: amp * (1.0 - s) });
+            events.push(crate::report::PointEvent {
+                layer: k,
+                sample: i,
+                amount_mm: amp * (1.0 - s),
+            });
         }
     }
     for (k, section) in sections.iter_mut().enumerate() {

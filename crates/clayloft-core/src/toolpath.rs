@@ -46,12 +46,18 @@ pub struct Toolpath {
 impl Toolpath {
     /// Length of the extrusion path, mm.
     pub fn length(&self) -> f64 {
-        self.points.windows(2).map(|w| w[0].pos.distance(w[1].pos)).sum()
+        self.points
+            .windows(2)
+            .map(|w| w[0].pos.distance(w[1].pos))
+            .sum()
     }
 
     /// Printing time along the path, s (approach and exit not included).
     pub fn print_time(&self) -> f64 {
-        self.points.windows(2).map(|w| w[0].pos.distance(w[1].pos) / w[1].speed).sum()
+        self.points
+            .windows(2)
+            .map(|w| w[0].pos.distance(w[1].pos) / w[1].speed)
+            .sum()
     }
 }
 
@@ -63,18 +69,19 @@ struct PathBuilder {
 
 impl PathBuilder {
     fn push(&mut self, pos: DVec3, thickness: f64) {
-        let len = self.points.len();
-        if let Some(last) = self.points.last_mut()
+        if let Some(last) = self.points.last()
             && last.pos.truncate().distance(pos.truncate()) < MIN_SEGMENT
         {
-            // Same place: keep the later height (a pure lift would extrude nothing).
-            if (last.pos.z - pos.z).abs() > 1e-9 && len > 1 {
-                last.pos = pos;
-                last.thickness = last.thickness.max(thickness);
-            }
+            // Same place (a junction between layers): a pure lift would extrude nothing, so the
+            // next point rises instead.
             return;
         }
-        self.points.push(PathPoint { pos, thickness, flow: 1.0, speed: self.speed });
+        self.points.push(PathPoint {
+            pos,
+            thickness,
+            flow: 1.0,
+            speed: self.speed,
+        });
     }
 }
 
@@ -87,11 +94,20 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     let a = p.min_layer_height;
     let base = design.shape.base_layers.min(layers.saturating_sub(1));
     let n = sections[0].points.len();
-    let mut b = PathBuilder { points: Vec::with_capacity((layers + 2) * (n + 1)), speed: p.print_speed };
+    let mut b = PathBuilder {
+        points: Vec::with_capacity((layers + 2) * (n + 1)),
+        speed: p.print_speed,
+    };
 
     // 1. Spiral base: layers 1 ..= base, alternating direction so the last one ends at the wall.
+    //    All layers share one ring layout (from the widest), so their rings stack.
+    let r_max = (1..=base)
+        .flat_map(|k| sections[k].points.iter())
+        .map(|q| q.truncate().distance(surface.center))
+        .fold(0.0, f64::max);
+    let rings = BaseRings::new(r_max, p.line_width);
     for layer in 1..=base {
-        let geometry = base_layer(&sections[layer], surface.center, p.line_width, layer as f64 * h)
+        let geometry = base_layer(&sections[layer], surface.center, rings, layer as f64 * h)
             .ok_or_else(|| {
                 FieldError::new(
                     "shape.base_layers",
@@ -100,8 +116,11 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
             })?;
         let outward = (base - layer) % 2 == 0;
         let start = b.points.len();
-        let ordered: Box<dyn Iterator<Item = &DVec3>> =
-            if outward { Box::new(geometry.iter()) } else { Box::new(geometry.iter().rev()) };
+        let ordered: Box<dyn Iterator<Item = &DVec3>> = if outward {
+            Box::new(geometry.iter())
+        } else {
+            Box::new(geometry.iter().rev())
+        };
         for q in ordered {
             b.push(*q, h);
         }
@@ -134,14 +153,24 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
         for i in 1..=n {
             let f = frac[i];
             let j = i % n;
-            let xy = lo.points[j].truncate().lerp(hi.points[j].truncate(), f);
-            let z = if k == first {
-                // Leave the flat revolution by at least the minimum layer height.
+            let (z, g) = if k == first {
+                // Leave the flat revolution by at least the minimum layer height; XY follows the
+                // z progress so the lean never exceeds that of the sections.
                 let z0 = flat_z + a;
-                z0 + (hi.points[j].z - z0) * f
+                let z = z0 + (hi.points[j].z - z0) * f;
+                let rise = hi.points[j].z - flat_z;
+                (
+                    z,
+                    if rise > 0.0 {
+                        ((z - flat_z) / rise).clamp(0.0, 1.0)
+                    } else {
+                        f
+                    },
+                )
             } else {
-                lo.points[j].z + (hi.points[j].z - lo.points[j].z) * f
+                (lo.points[j].z + (hi.points[j].z - lo.points[j].z) * f, f)
             };
+            let xy = lo.points[j].truncate().lerp(hi.points[j].truncate(), g);
             let thickness = z - z_below[j];
             b.push(DVec3::new(xy.x, xy.y, z), thickness);
             z_now[j] = z;
@@ -169,8 +198,16 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     }
 
     let mut points = b.points;
-    apply_flow_ramps(&mut points[wall_start..], p.flow_ramp_start, p.flow_ramp_end);
-    Ok(Toolpath { points, base_points, revolutions })
+    apply_flow_ramps(
+        &mut points[wall_start..],
+        p.flow_ramp_start,
+        p.flow_ramp_end,
+    );
+    Ok(Toolpath {
+        points,
+        base_points,
+        revolutions,
+    })
 }
 
 /// Fraction of the section's closed length reached at each vertex: `f[i] = s_i / L`, i = 0 ..= n.
@@ -181,17 +218,36 @@ fn arc_fractions(section: &Section) -> Vec<f64> {
     s.iter().map(|v| v / total).collect()
 }
 
-/// One flat base layer at height `z`: an Archimedean-like spiral of the section scaled about the
-/// centre, `c + σ(P_i − c)` with σ rising from `σ₀` to 1 over whole turns, so that neighbouring
-/// turns are at most one line width apart, then the full perimeter. Ends at the section's
+/// Ring layout of the spiral base: the scale σ rises from `sigma0` to 1 over `turns` turns.
+#[derive(Debug, Clone, Copy)]
+struct BaseRings {
+    sigma0: f64,
+    turns: usize,
+}
+
+impl BaseRings {
+    /// Turns at most one line width apart at the widest radius `r_max`, and a centre hole of
+    /// half a line width.
+    fn new(r_max: f64, line_width: f64) -> BaseRings {
+        let sigma0 = (0.5 * line_width / r_max.max(1e-9)).min(1.0);
+        let turns = (((1.0 - sigma0) * r_max) / line_width).ceil().max(1.0) as usize;
+        BaseRings { sigma0, turns }
+    }
+}
+
+/// One flat base layer at height `z`: a spiral of the section scaled about the centre,
+/// `c + σ(P_i − c)` with σ following `rings`, then the full perimeter. Ends at the section's
 /// point 0. `None` if the section is not star-shaped around the centre.
-fn base_layer(section: &Section, center: DVec2, line_width: f64, z: f64) -> Option<Vec<DVec3>> {
+fn base_layer(section: &Section, center: DVec2, rings: BaseRings, z: f64) -> Option<Vec<DVec3>> {
     let xy = section.xy();
     let n = xy.len();
     // Star-shaped: the angle seen from the centre must keep increasing all the way round.
     let mut total_turn = 0.0;
     for i in 0..n {
-        let d = crate::control::angle_difference((xy[(i + 1) % n] - center).to_angle(), (xy[i] - center).to_angle());
+        let d = crate::control::angle_difference(
+            (xy[(i + 1) % n] - center).to_angle(),
+            (xy[i] - center).to_angle(),
+        );
         if d <= 0.0 {
             return None;
         }
@@ -200,13 +256,12 @@ fn base_layer(section: &Section, center: DVec2, line_width: f64, z: f64) -> Opti
     if (total_turn - std::f64::consts::TAU).abs() > 1e-6 {
         return None;
     }
-    let r_max = xy.iter().map(|p| p.distance(center)).fold(0.0, f64::max);
-    let sigma0 = (0.5 * line_width / r_max).min(1.0);
-    let turns = (((1.0 - sigma0) * r_max) / line_width).ceil().max(1.0) as usize;
+    let BaseRings { sigma0, turns } = rings;
     let mut out = Vec::with_capacity((turns + 1) * n + 1);
     for turn in 0..turns {
         for (i, p) in xy.iter().enumerate() {
-            let sigma = sigma0 + (1.0 - sigma0) * (turn as f64 + i as f64 / n as f64) / turns as f64;
+            let sigma =
+                sigma0 + (1.0 - sigma0) * (turn as f64 + i as f64 / n as f64) / turns as f64;
             let q = center + (*p - center) * sigma;
             out.push(DVec3::new(q.x, q.y, z));
         }
@@ -225,7 +280,9 @@ fn apply_min_layer_time(points: &mut [PathPoint], start: usize, min_time: f64) {
         return;
     }
     let from = start.max(1);
-    let time: f64 = (from..points.len()).map(|i| points[i - 1].pos.distance(points[i].pos) / points[i].speed).sum();
+    let time: f64 = (from..points.len())
+        .map(|i| points[i - 1].pos.distance(points[i].pos) / points[i].speed)
+        .sum();
     if time < min_time && time > 0.0 {
         let factor = time / min_time;
         for q in points[from..].iter_mut() {
@@ -290,7 +347,11 @@ mod tests {
         }
         // Every point within the printable layer heights.
         for q in pts {
-            assert!(q.thickness >= 0.25 - 1e-9 && q.thickness <= 1.0 + 1e-9, "{}", q.thickness);
+            assert!(
+                q.thickness >= 0.25 - 1e-9 && q.thickness <= 1.0 + 1e-9,
+                "{}",
+                q.thickness
+            );
         }
         assert!((pts.last().unwrap().pos.z - 20.0).abs() < 1e-9);
     }
@@ -307,10 +368,17 @@ mod tests {
         // Two base layers: first inward (starts at the edge), second outward (starts at centre).
         let first = tp.points[0].pos.truncate();
         assert!((first.distance(c) - 30.0).abs() < 1e-6);
-        let nearest = tp.points[..tp.base_points].iter().map(|q| q.pos.truncate().distance(c)).fold(f64::MAX, f64::min);
+        let nearest = tp.points[..tp.base_points]
+            .iter()
+            .map(|q| q.pos.truncate().distance(c))
+            .fold(f64::MAX, f64::min);
         assert!(nearest <= 1.5 + 1e-9, "{nearest}");
         // Base layers sit at z = 1 and 2.
-        assert!(tp.points[..tp.base_points].iter().all(|q| q.pos.z == 1.0 || q.pos.z == 2.0));
+        assert!(
+            tp.points[..tp.base_points]
+                .iter()
+                .all(|q| q.pos.z == 1.0 || q.pos.z == 2.0)
+        );
     }
 
     #[test]

@@ -33,17 +33,26 @@ fn finite(field: &str, v: f64) -> Check {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(FieldError::new(field, format!("must be a finite number, got {v}")))
+        Err(FieldError::new(
+            field,
+            format!("must be a finite number, got {v}"),
+        ))
     }
 }
 
 fn positive(field: &str, v: f64, unit: &str) -> Check {
     finite(field, v)?;
     if v <= 0.0 {
-        return Err(FieldError::new(field, format!("must be greater than 0 {unit}, got {v}")));
+        return Err(FieldError::new(
+            field,
+            format!("must be greater than 0 {unit}, got {v}"),
+        ));
     }
     if v > MAX_LENGTH {
-        return Err(FieldError::new(field, format!("{v} {unit} is absurdly large (at most {MAX_LENGTH})")));
+        return Err(FieldError::new(
+            field,
+            format!("{v} {unit} is absurdly large (at most {MAX_LENGTH})"),
+        ));
     }
     Ok(())
 }
@@ -51,7 +60,10 @@ fn positive(field: &str, v: f64, unit: &str) -> Check {
 fn in_range(field: &str, v: f64, lo: f64, hi: f64, why: &str) -> Check {
     finite(field, v)?;
     if v < lo || v > hi {
-        return Err(FieldError::new(field, format!("{v} is outside {lo} ..= {hi} ({why})")));
+        return Err(FieldError::new(
+            field,
+            format!("{v} is outside {lo} ..= {hi} ({why})"),
+        ));
     }
     Ok(())
 }
@@ -62,7 +74,10 @@ pub fn validate(d: &Design) -> Check {
     if d.version != DESIGN_VERSION {
         return Err(FieldError::new(
             "version",
-            format!("this Clayloft reads design version {DESIGN_VERSION}, the file says {}", d.version),
+            format!(
+                "this Clayloft reads design version {DESIGN_VERSION}, the file says {}",
+                d.version
+            ),
         ));
     }
     let p = &d.printer;
@@ -71,13 +86,22 @@ pub fn validate(d: &Design) -> Check {
     positive("printer.max_z", p.max_z, "mm")?;
     positive("printer.nozzle_diameter", p.nozzle_diameter, "mm")?;
     positive("printer.line_width", p.line_width, "mm")?;
-    in_range("printer.line_width", p.line_width, 0.1, 50.0, "a bead width in mm")?;
+    in_range(
+        "printer.line_width",
+        p.line_width,
+        0.1,
+        50.0,
+        "a bead width in mm",
+    )?;
     positive("printer.min_layer_height", p.min_layer_height, "mm")?;
     positive("printer.max_layer_height", p.max_layer_height, "mm")?;
     if p.max_layer_height < p.min_layer_height {
         return Err(FieldError::new(
             "printer.max_layer_height",
-            format!("{} mm is below printer.min_layer_height = {} mm", p.max_layer_height, p.min_layer_height),
+            format!(
+                "{} mm is below printer.min_layer_height = {} mm",
+                p.max_layer_height, p.min_layer_height
+            ),
         ));
     }
     finite("printer.layer_height", p.layer_height)?;
@@ -91,33 +115,72 @@ pub fn validate(d: &Design) -> Check {
         ));
     }
     positive("printer.nozzle_length", p.nozzle_length, "mm")?;
-    in_range("printer.max_overhang_deg", p.max_overhang_deg, 1.0, 80.0, "degrees from vertical")?;
+    in_range(
+        "printer.max_overhang_deg",
+        p.max_overhang_deg,
+        1.0,
+        80.0,
+        "degrees from vertical",
+    )?;
     in_range("printer.print_speed", p.print_speed, 0.1, 1000.0, "mm/s")?;
     in_range("printer.travel_speed", p.travel_speed, 0.1, 1000.0, "mm/s")?;
     positive("printer.feed_diameter", p.feed_diameter, "mm")?;
-    in_range("printer.flow_multiplier", p.flow_multiplier, 0.01, 10.0, "a factor on the extruded volume")?;
-    in_range("printer.min_layer_time", p.min_layer_time, 0.0, 3600.0, "seconds per revolution")?;
-    in_range("printer.flow_ramp_start", p.flow_ramp_start, 0.0, MAX_LENGTH, "mm of path")?;
-    in_range("printer.flow_ramp_end", p.flow_ramp_end, 0.0, MAX_LENGTH, "mm of path")?;
+    in_range(
+        "printer.flow_multiplier",
+        p.flow_multiplier,
+        0.01,
+        10.0,
+        "a factor on the extruded volume",
+    )?;
+    in_range(
+        "printer.min_layer_time",
+        p.min_layer_time,
+        0.0,
+        3600.0,
+        "seconds per revolution",
+    )?;
+    in_range(
+        "printer.flow_ramp_start",
+        p.flow_ramp_start,
+        0.0,
+        MAX_LENGTH,
+        "mm of path",
+    )?;
+    in_range(
+        "printer.flow_ramp_end",
+        p.flow_ramp_end,
+        0.0,
+        MAX_LENGTH,
+        "mm of path",
+    )?;
 
     let s = &d.shape;
     positive("shape.height", s.height, "mm")?;
     if s.height > p.max_z {
         return Err(FieldError::new(
             "shape.height",
-            format!("{} mm is taller than the printer's build height printer.max_z = {} mm", s.height, p.max_z),
+            format!(
+                "{} mm is taller than the printer's build height printer.max_z = {} mm",
+                s.height, p.max_z
+            ),
         ));
     }
     if s.height < p.layer_height {
         return Err(FieldError::new(
             "shape.height",
-            format!("{} mm is less than one layer ({} mm)", s.height, p.layer_height),
+            format!(
+                "{} mm is less than one layer ({} mm)",
+                s.height, p.layer_height
+            ),
         ));
     }
     if s.samples < 3 || s.samples > MAX_SAMPLES {
         return Err(FieldError::new(
             "shape.samples",
-            format!("{} is outside 3 ..= {MAX_SAMPLES} points per section", s.samples),
+            format!(
+                "{} is outside 3 ..= {MAX_SAMPLES} points per section",
+                s.samples
+            ),
         ));
     }
     if let Some([cx, cy]) = s.center {
@@ -128,7 +191,10 @@ pub fn validate(d: &Design) -> Check {
     if s.base_layers as f64 >= layers_nominal {
         return Err(FieldError::new(
             "shape.base_layers",
-            format!("{} base layers leave no wall in a {} mm tall vessel", s.base_layers, s.height),
+            format!(
+                "{} base layers leave no wall in a {} mm tall vessel",
+                s.base_layers, s.height
+            ),
         ));
     }
     contour("shape.lower", &s.lower)?;
@@ -137,7 +203,10 @@ pub fn validate(d: &Design) -> Check {
     for (n, line) in d.control.vertical.iter().enumerate() {
         let f = format!("control.vertical[{n}]");
         if line.points.is_empty() {
-            return Err(FieldError::new(format!("{f}.points"), "needs at least one [t, offset] point"));
+            return Err(FieldError::new(
+                format!("{f}.points"),
+                "needs at least one [t, offset] point",
+            ));
         }
         let mut last_t = f64::NEG_INFINITY;
         for (k, [t, off]) in line.points.iter().copied().enumerate() {
@@ -145,17 +214,29 @@ pub fn validate(d: &Design) -> Check {
             in_range(&pf, t, 0.0, 1.0, "t is a height fraction")?;
             in_range(&pf, off, -MAX_LENGTH, MAX_LENGTH, "offset in mm")?;
             if t <= last_t {
-                return Err(FieldError::new(pf, "t values must increase from point to point"));
+                return Err(FieldError::new(
+                    pf,
+                    "t values must increase from point to point",
+                ));
             }
             last_t = t;
         }
         match (line.angle, line.width) {
             (Some(a), w) => {
                 in_range(&format!("{f}.angle"), a, -360.0, 360.0, "degrees")?;
-                in_range(&format!("{f}.width"), w.unwrap_or(60.0), 1.0, 360.0, "degrees of influence")?;
+                in_range(
+                    &format!("{f}.width"),
+                    w.unwrap_or(60.0),
+                    1.0,
+                    360.0,
+                    "degrees of influence",
+                )?;
             }
             (None, Some(_)) => {
-                return Err(FieldError::new(format!("{f}.width"), "a width needs an angle to act around"));
+                return Err(FieldError::new(
+                    format!("{f}.width"),
+                    "a width needs an angle to act around",
+                ));
             }
             (None, None) => {}
         }
@@ -163,17 +244,35 @@ pub fn validate(d: &Design) -> Check {
     for (n, line) in d.control.horizontal.iter().enumerate() {
         let f = format!("control.horizontal[{n}]");
         in_range(&format!("{f}.at"), line.at, 0.0, 1.0, "a height fraction")?;
-        in_range(&format!("{f}.reach"), line.reach, 0.001, 1.0, "a height fraction")?;
+        in_range(
+            &format!("{f}.reach"),
+            line.reach,
+            0.001,
+            1.0,
+            "a height fraction",
+        )?;
         if line.points.is_empty() {
-            return Err(FieldError::new(format!("{f}.points"), "needs at least one [angle, dz] point"));
+            return Err(FieldError::new(
+                format!("{f}.points"),
+                "needs at least one [angle, dz] point",
+            ));
         }
         let mut last_a = f64::NEG_INFINITY;
         for (k, [a, dz]) in line.points.iter().copied().enumerate() {
             let pf = format!("{f}.points[{k}]");
             in_range(&pf, a, 0.0, 359.999_999, "angle in degrees, 0 ..< 360")?;
-            in_range(&pf, dz, -p.max_z, p.max_z, "dz in mm within the build height")?;
+            in_range(
+                &pf,
+                dz,
+                -p.max_z,
+                p.max_z,
+                "dz in mm within the build height",
+            )?;
             if a <= last_a {
-                return Err(FieldError::new(pf, "angles must increase from point to point"));
+                return Err(FieldError::new(
+                    pf,
+                    "angles must increase from point to point",
+                ));
             }
             last_a = a;
         }
@@ -185,18 +284,33 @@ pub fn validate(d: &Design) -> Check {
         if let Some(w) = &t.y {
             wave("texture.y", w)?;
         }
-        in_range("texture.phase_drift", t.phase_drift, -1e4, 1e4, "samples per layer")?;
+        in_range(
+            "texture.phase_drift",
+            t.phase_drift,
+            -1e4,
+            1e4,
+            "samples per layer",
+        )?;
         in_range("texture.start", t.start, 0.0, 1.0, "a height fraction")?;
         in_range("texture.end", t.end, 0.0, 1.0, "a height fraction")?;
         if t.end < t.start {
-            return Err(FieldError::new("texture.end", "must not be below texture.start"));
+            return Err(FieldError::new(
+                "texture.end",
+                "must not be below texture.start",
+            ));
         }
     }
     Ok(())
 }
 
 fn wave(f: &str, w: &Wave) -> Check {
-    in_range(&format!("{f}.period"), w.period, 1e-3, 1e6, "samples or layers per period")?;
+    in_range(
+        &format!("{f}.period"),
+        w.period,
+        1e-3,
+        1e6,
+        "samples or layers per period",
+    )?;
     in_range(&format!("{f}.amplitude"), w.amplitude, -100.0, 100.0, "mm")?;
     Ok(())
 }
@@ -209,49 +323,96 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             positive(&fld("rx"), *rx, "mm")?;
             positive(&fld("ry"), *ry, "mm")
         }
-        ContourSpec::Polygon { sides, radius, corner_radius } => {
+        ContourSpec::Polygon {
+            sides,
+            radius,
+            corner_radius,
+        } => {
             if !(3..=1000).contains(sides) {
-                return Err(FieldError::new(fld("sides"), format!("{sides} is outside 3 ..= 1000")));
+                return Err(FieldError::new(
+                    fld("sides"),
+                    format!("{sides} is outside 3 ..= 1000"),
+                ));
             }
             positive(&fld("radius"), *radius, "mm")?;
             let inradius = radius * (std::f64::consts::PI / *sides as f64).cos();
-            in_range(&fld("corner_radius"), *corner_radius, 0.0, inradius * 0.999, "must fit inside the polygon")
+            in_range(
+                &fld("corner_radius"),
+                *corner_radius,
+                0.0,
+                inradius * 0.999,
+                "must fit inside the polygon",
+            )
         }
-        ContourSpec::Star { points, outer_radius, inner_radius } => {
+        ContourSpec::Star {
+            points,
+            outer_radius,
+            inner_radius,
+        } => {
             if !(2..=1000).contains(points) {
-                return Err(FieldError::new(fld("points"), format!("{points} is outside 2 ..= 1000")));
+                return Err(FieldError::new(
+                    fld("points"),
+                    format!("{points} is outside 2 ..= 1000"),
+                ));
             }
             positive(&fld("outer_radius"), *outer_radius, "mm")?;
             positive(&fld("inner_radius"), *inner_radius, "mm")?;
             if inner_radius >= outer_radius {
-                return Err(FieldError::new(fld("inner_radius"), "must be smaller than outer_radius"));
+                return Err(FieldError::new(
+                    fld("inner_radius"),
+                    "must be smaller than outer_radius",
+                ));
             }
             Ok(())
         }
-        ContourSpec::Rose { radius, amplitude, petals } => {
+        ContourSpec::Rose {
+            radius,
+            amplitude,
+            petals,
+        } => {
             positive(&fld("radius"), *radius, "mm")?;
             finite(&fld("amplitude"), *amplitude)?;
             if amplitude.abs() >= *radius {
                 return Err(FieldError::new(
                     fld("amplitude"),
-                    format!("|{amplitude}| mm must be smaller than radius = {radius} mm so the curve stays closed"),
+                    format!(
+                        "|{amplitude}| mm must be smaller than radius = {radius} mm so the curve stays closed"
+                    ),
                 ));
             }
             if !(1..=500).contains(petals) {
-                return Err(FieldError::new(fld("petals"), format!("{petals} is outside 1 ..= 500")));
+                return Err(FieldError::new(
+                    fld("petals"),
+                    format!("{petals} is outside 1 ..= 500"),
+                ));
             }
             Ok(())
         }
         ContourSpec::Spline { points } => {
             if points.len() < 3 {
-                return Err(FieldError::new(fld("points"), "a closed spline needs at least 3 points"));
+                return Err(FieldError::new(
+                    fld("points"),
+                    "a closed spline needs at least 3 points",
+                ));
             }
             if points.len() > MAX_SAMPLES {
                 return Err(FieldError::new(fld("points"), "too many points"));
             }
             for (k, [x, y]) in points.iter().copied().enumerate() {
-                in_range(&format!("{f}.points[{k}]"), x, -MAX_LENGTH, MAX_LENGTH, "mm")?;
-                in_range(&format!("{f}.points[{k}]"), y, -MAX_LENGTH, MAX_LENGTH, "mm")?;
+                in_range(
+                    &format!("{f}.points[{k}]"),
+                    x,
+                    -MAX_LENGTH,
+                    MAX_LENGTH,
+                    "mm",
+                )?;
+                in_range(
+                    &format!("{f}.points[{k}]"),
+                    y,
+                    -MAX_LENGTH,
+                    MAX_LENGTH,
+                    "mm",
+                )?;
             }
             Ok(())
         }
