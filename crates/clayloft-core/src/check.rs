@@ -103,12 +103,18 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
     let (mut absolute_xyz, mut absolute_e) = (true, true);
     for (idx, raw) in text.lines().enumerate() {
         let line = idx + 1;
-        let code = raw.split(';').next().unwrap_or("").trim();
+        // Drop the comment and a host checksum (`*nn`).
+        let code = raw.split(';').next().unwrap_or("").split('*').next().unwrap_or("").trim();
         if code.is_empty() {
             continue;
         }
         let mut words = code.split_whitespace();
-        let Some(cmd) = words.next() else { continue };
+        let Some(mut cmd) = words.next() else { continue };
+        // A line number (`N12 G1 …`) comes before the command.
+        if cmd.starts_with(['N', 'n']) && cmd[1..].parse::<u64>().is_ok() {
+            let Some(next) = words.next() else { continue };
+            cmd = next;
+        }
         let arg = |letter: char| -> Result<Option<f64>, GcodeError> {
             for w in code.split_whitespace().skip(1) {
                 let mut chars = w.chars();
@@ -173,7 +179,7 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
                 });
             }
             "G28" => pos = DVec3::ZERO,
-            c if c.starts_with(['G', 'M', 'T', 'N', 'F', 'S']) => {}
+            c if c.starts_with(['G', 'M', 'T', 'N', 'F', 'S']) && c[1..].parse::<f64>().is_ok() => {}
             other => {
                 return Err(GcodeError {
                     line,
@@ -181,7 +187,6 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
                 });
             }
         }
-        let _ = words;
     }
     Ok((moves, start.unwrap_or(DVec3::ZERO)))
 }
@@ -683,6 +688,13 @@ mod tests {
         let r = check_gcode(g, &l).unwrap();
         assert!(r.ok(), "{r}");
         assert_eq!(r.extruding_moves, 3);
+    }
+
+    #[test]
+    fn line_numbers_and_checksums_are_understood() {
+        let (moves, _) = parse_moves("N1 G1 X10 Y10 Z1 E1*37\nN2 G1 X20 Y10 Z1 E1*38\n").unwrap();
+        assert_eq!(moves.len(), 2);
+        assert_eq!(moves[1].to, DVec3::new(20.0, 10.0, 1.0));
     }
 
     #[test]
