@@ -32,7 +32,11 @@ fn text(b: &[u8]) -> String {
 fn assert_bad_input(out: &Output, needles: &[&str]) {
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "one line expected: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "one line expected: {err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
     for n in needles {
         assert!(err.contains(n), "`{n}` not in: {err}");
@@ -50,25 +54,66 @@ fn every_shipped_design_prints_and_passes_check() {
         let out = clayloft(&["gcode", d.to_str().unwrap(), "-o", gcode.to_str().unwrap()]);
         assert!(out.status.success(), "{name}: {}", text(&out.stderr));
         let summary = text(&out.stdout);
-        for key in ["layers:", "points:", "path length:", "estimated time:", "max overhang:", "max z range per layer:", "corrections"] {
-            assert!(summary.contains(key), "{name}: `{key}` missing from\n{summary}");
+        for key in [
+            "layers:",
+            "points:",
+            "path length:",
+            "estimated time:",
+            "max overhang:",
+            "max z range per layer:",
+            "corrections",
+        ] {
+            assert!(
+                summary.contains(key),
+                "{name}: `{key}` missing from\n{summary}"
+            );
         }
-        let check = clayloft(&["check", gcode.to_str().unwrap(), "--design", d.to_str().unwrap()]);
-        assert_eq!(check.status.code(), Some(0), "{name}:\n{}{}", text(&check.stdout), text(&check.stderr));
+        let check = clayloft(&[
+            "check",
+            gcode.to_str().unwrap(),
+            "--design",
+            d.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            check.status.code(),
+            Some(0),
+            "{name}:\n{}{}",
+            text(&check.stdout),
+            text(&check.stderr)
+        );
         assert!(text(&check.stdout).contains("all limits hold"));
         // The header alone carries the limits too.
         let alone = clayloft(&["check", gcode.to_str().unwrap()]);
-        assert_eq!(alone.status.code(), Some(0), "{name}: {}", text(&alone.stdout));
+        assert_eq!(
+            alone.status.code(),
+            Some(0),
+            "{name}: {}",
+            text(&alone.stdout)
+        );
     }
 }
 
 #[test]
 fn examples_cover_every_feature() {
-    let all: String = designs().iter().map(|p| std::fs::read_to_string(p).unwrap()).collect();
+    let all: String = designs()
+        .iter()
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect();
     for needle in [
-        "type = \"circle\"", "type = \"ellipse\"", "type = \"polygon\"", "type = \"star\"", "type = \"rose\"",
-        "type = \"spline\"", "[[control.vertical]]", "angle = ", "[[control.horizontal]]", "wave = \"sine\"",
-        "wave = \"triangle\"", "wave = \"square\"", "combine = \"product\"", "combine = \"sum\"",
+        "type = \"circle\"",
+        "type = \"ellipse\"",
+        "type = \"polygon\"",
+        "type = \"star\"",
+        "type = \"rose\"",
+        "type = \"spline\"",
+        "[[control.vertical]]",
+        "angle = ",
+        "[[control.horizontal]]",
+        "wave = \"sine\"",
+        "wave = \"triangle\"",
+        "wave = \"square\"",
+        "combine = \"product\"",
+        "combine = \"sum\"",
     ] {
         assert!(all.contains(needle), "no example uses {needle}");
     }
@@ -78,27 +123,52 @@ fn examples_cover_every_feature() {
 fn corrections_are_reported_for_the_design_that_needs_them() {
     let dir = tempfile::tempdir().unwrap();
     let g = dir.path().join("bowl.gcode");
-    let out = clayloft(&["gcode", "assets/designs/flared-bowl.toml", "-o", g.to_str().unwrap()]);
+    let out = clayloft(&[
+        "gcode",
+        "assets/designs/flared-bowl.toml",
+        "-o",
+        g.to_str().unwrap(),
+    ]);
     let s = text(&out.stdout);
     assert!(s.contains("corrected: layers"), "{s}");
     assert!(s.contains("max overhang: 44."), "{s}");
-    let paper = clayloft(&["gcode", "assets/designs/paper-woven.toml", "-o", g.to_str().unwrap()]);
-    assert!(text(&paper.stdout).contains("texture amplitude lowered"), "{}", text(&paper.stdout));
+    let paper = clayloft(&[
+        "gcode",
+        "assets/designs/paper-woven.toml",
+        "-o",
+        g.to_str().unwrap(),
+    ]);
+    assert!(
+        text(&paper.stdout).contains("texture amplitude lowered"),
+        "{}",
+        text(&paper.stdout)
+    );
 }
 
 #[test]
 fn enforcement_off_reports_violations_and_check_exits_1() {
     let dir = tempfile::tempdir().unwrap();
-    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs/flared-bowl.toml")).unwrap();
+    let src = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs/flared-bowl.toml"),
+    )
+    .unwrap();
     let design = dir.path().join("bowl.toml");
     std::fs::write(&design, src.replace("enforce = true", "enforce = false")).unwrap();
     let g = dir.path().join("bowl.gcode");
     let out = clayloft(&["gcode", design.to_str().unwrap(), "-o", g.to_str().unwrap()]);
     assert!(out.status.success());
-    assert!(text(&out.stdout).contains("VIOLATION"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("VIOLATION"),
+        "{}",
+        text(&out.stdout)
+    );
     let check = clayloft(&["check", g.to_str().unwrap()]);
     assert_eq!(check.status.code(), Some(1), "{}", text(&check.stdout));
-    assert!(text(&check.stdout).contains("VIOLATION overhang"), "{}", text(&check.stdout));
+    assert!(
+        text(&check.stdout).contains("VIOLATION overhang"),
+        "{}",
+        text(&check.stdout)
+    );
 }
 
 #[test]
@@ -106,7 +176,16 @@ fn gcode_output_is_deterministic() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a.gcode"), dir.path().join("b.gcode"));
     for p in [&a, &b] {
-        assert!(clayloft(&["gcode", "assets/designs/petal-vase.toml", "-o", p.to_str().unwrap()]).status.success());
+        assert!(
+            clayloft(&[
+                "gcode",
+                "assets/designs/petal-vase.toml",
+                "-o",
+                p.to_str().unwrap()
+            ])
+            .status
+            .success()
+        );
     }
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
 }
@@ -123,7 +202,8 @@ fn assert_stl_closed_manifold(bytes: &[u8]) {
         let v: Vec<usize> = (0..3)
             .map(|k| {
                 let o = base + 12 * k;
-                let key = [0, 4, 8].map(|c| u32::from_le_bytes(bytes[o + c..o + c + 4].try_into().unwrap()));
+                let key = [0, 4, 8]
+                    .map(|c| u32::from_le_bytes(bytes[o + c..o + c + 4].try_into().unwrap()));
                 let next = ids.len();
                 *ids.entry(key).or_insert(next)
             })
@@ -134,21 +214,38 @@ fn assert_stl_closed_manifold(bytes: &[u8]) {
     }
     for (&(a, b), &n) in &edges {
         assert_eq!(n, 1, "edge used twice in one direction");
-        assert_eq!(edges.get(&(b, a)), Some(&1), "edge without a twin: not closed");
+        assert_eq!(
+            edges.get(&(b, a)),
+            Some(&1),
+            "edge without a twin: not closed"
+        );
     }
 }
 
 #[test]
 fn stl_is_a_closed_two_manifold() {
     let dir = tempfile::tempdir().unwrap();
-    for design in ["assets/designs/petal-vase.toml", "assets/designs/tilted-rim.toml"] {
+    for design in [
+        "assets/designs/petal-vase.toml",
+        "assets/designs/tilted-rim.toml",
+    ] {
         let stl = dir.path().join("v.stl");
         let out = clayloft(&["stl", design, "-o", stl.to_str().unwrap()]);
         assert!(out.status.success(), "{}", text(&out.stderr));
         assert_stl_closed_manifold(&std::fs::read(&stl).unwrap());
     }
     let ascii = dir.path().join("v.txt.stl");
-    assert!(clayloft(&["stl", "assets/designs/hex-fluted.toml", "-o", ascii.to_str().unwrap(), "--ascii"]).status.success());
+    assert!(
+        clayloft(&[
+            "stl",
+            "assets/designs/hex-fluted.toml",
+            "-o",
+            ascii.to_str().unwrap(),
+            "--ascii"
+        ])
+        .status
+        .success()
+    );
     let t = std::fs::read_to_string(&ascii).unwrap();
     assert!(t.starts_with("solid ") && t.trim_end().ends_with("endsolid fluted hexagon cup"));
 }
@@ -168,28 +265,83 @@ fn bad_design(design: &[u8], needles: &[&str]) {
     let path = dir.path().join("bad.toml");
     std::fs::write(&path, design).unwrap();
     let out_path = dir.path().join("out.gcode");
-    let out = clayloft(&["gcode", path.to_str().unwrap(), "-o", out_path.to_str().unwrap()]);
+    let out = clayloft(&[
+        "gcode",
+        path.to_str().unwrap(),
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
     let mut all = vec!["bad.toml"];
     all.extend_from_slice(needles);
     assert_bad_input(&out, &all);
     assert!(!out_path.exists(), "no output file on error");
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "nothing left behind");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "nothing left behind"
+    );
 }
 
 #[test]
 fn bad_design_files() {
-    bad_design(GOOD.replace("height", "heigth").as_bytes(), &[":3:", "heigth"]);
-    bad_design(GOOD.replace("60.0", "-60.0").as_bytes(), &[":3:", "shape.height", "greater than 0"]);
-    bad_design(GOOD.replace("radius = 40.0", "radius = nan").as_bytes(), &[":6:", "shape.lower.radius", "finite"]);
-    bad_design(GOOD.replace("radius = 40.0", "radius = inf").as_bytes(), &["shape.lower.radius"]);
-    bad_design(GOOD.replace("height = 60.0", "height = 60.0\nsamples = 2").as_bytes(), &[":4:", "shape.samples"]);
-    bad_design(GOOD.replace("height = 60.0", "height = 60.0\nsamples = 900000000").as_bytes(), &["shape.samples"]);
-    bad_design(format!("{GOOD}[printer]\nlayer_height = 2.0\n").as_bytes(), &["printer.layer_height", "printer's range"]);
-    bad_design(GOOD.replace("radius = 40.0", "radius = 95.0").as_bytes(), &["shape", "bed"]);
-    bad_design(GOOD.replace("height = 60.0", "height = 260.0").as_bytes(), &["shape.height", "build height"]);
-    bad_design(GOOD.replace("type = \"circle\"\nradius = 40.0", "type = \"image\"\npath = \"leaf.png\"\nsize = 80.0").as_bytes(), &["not supported yet"]);
-    bad_design(GOOD.replace("type = \"circle\"\nradius = 40.0", "type = \"spline\"\npoints = [[0.0, 0.0], [20.0, 20.0], [20.0, 0.0], [0.0, 20.0]]").as_bytes(), &["shape.lower", "crosses itself"]);
-    bad_design(GOOD.replace("version = 1", "version = 3").as_bytes(), &["version"]);
+    bad_design(
+        GOOD.replace("height", "heigth").as_bytes(),
+        &[":3:", "heigth"],
+    );
+    bad_design(
+        GOOD.replace("60.0", "-60.0").as_bytes(),
+        &[":3:", "shape.height", "greater than 0"],
+    );
+    bad_design(
+        GOOD.replace("radius = 40.0", "radius = nan").as_bytes(),
+        &[":6:", "shape.lower.radius", "finite"],
+    );
+    bad_design(
+        GOOD.replace("radius = 40.0", "radius = inf").as_bytes(),
+        &["shape.lower.radius"],
+    );
+    bad_design(
+        GOOD.replace("height = 60.0", "height = 60.0\nsamples = 2")
+            .as_bytes(),
+        &[":4:", "shape.samples"],
+    );
+    bad_design(
+        GOOD.replace("height = 60.0", "height = 60.0\nsamples = 900000000")
+            .as_bytes(),
+        &["shape.samples"],
+    );
+    bad_design(
+        format!("{GOOD}[printer]\nlayer_height = 2.0\n").as_bytes(),
+        &["printer.layer_height", "printer's range"],
+    );
+    bad_design(
+        GOOD.replace("radius = 40.0", "radius = 95.0").as_bytes(),
+        &["shape", "bed"],
+    );
+    bad_design(
+        GOOD.replace("height = 60.0", "height = 260.0").as_bytes(),
+        &["shape.height", "build height"],
+    );
+    bad_design(
+        GOOD.replace(
+            "type = \"circle\"\nradius = 40.0",
+            "type = \"image\"\npath = \"leaf.png\"\nsize = 80.0",
+        )
+        .as_bytes(),
+        &["not supported yet"],
+    );
+    bad_design(
+        GOOD.replace(
+            "type = \"circle\"\nradius = 40.0",
+            "type = \"spline\"\npoints = [[0.0, 0.0], [20.0, 20.0], [20.0, 0.0], [0.0, 20.0]]",
+        )
+        .as_bytes(),
+        &["shape.lower", "crosses itself"],
+    );
+    bad_design(
+        GOOD.replace("version = 1", "version = 3").as_bytes(),
+        &["version"],
+    );
     bad_design(b"version = 1\n[shape\n", &["bad.toml:2"]);
     bad_design(&[0u8, 159, 146, 150, 255, 0, 1, 2, 3], &["not a text"]);
     bad_design(b"", &["missing field"]);
@@ -203,14 +355,28 @@ fn missing_and_unreadable_inputs() {
     assert_bad_input(&out, &["assets/designs", "folder"]);
     let out = clayloft(&["check", "no/such/file.gcode"]);
     assert_bad_input(&out, &["no/such/file.gcode"]);
-    assert!(!Path::new(env!("CARGO_MANIFEST_DIR")).join("x.gcode").exists());
+    assert!(
+        !Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("x.gcode")
+            .exists()
+    );
 }
 
 #[test]
 fn output_into_a_missing_folder() {
-    let out = clayloft(&["gcode", "assets/designs/petal-vase.toml", "-o", "/no/such/folder/out.gcode"]);
+    let out = clayloft(&[
+        "gcode",
+        "assets/designs/petal-vase.toml",
+        "-o",
+        "/no/such/folder/out.gcode",
+    ]);
     assert_bad_input(&out, &["/no/such/folder/out.gcode", "does not exist"]);
-    let out = clayloft(&["stl", "assets/designs/petal-vase.toml", "-o", "/no/such/folder/out.stl"]);
+    let out = clayloft(&[
+        "stl",
+        "assets/designs/petal-vase.toml",
+        "-o",
+        "/no/such/folder/out.stl",
+    ]);
     assert_bad_input(&out, &["does not exist"]);
 }
 
@@ -219,11 +385,20 @@ fn check_rejects_files_that_are_not_gcode() {
     let dir = tempfile::tempdir().unwrap();
     let bin = dir.path().join("garbage.gcode");
     std::fs::write(&bin, [0u8, 255, 3, 7, 200]).unwrap();
-    assert_bad_input(&clayloft(&["check", bin.to_str().unwrap()]), &["garbage.gcode", "not a text"]);
+    assert_bad_input(
+        &clayloft(&["check", bin.to_str().unwrap()]),
+        &["garbage.gcode", "not a text"],
+    );
     let words = dir.path().join("words.gcode");
     std::fs::write(&words, "G1 X10 Y10\nthis is a letter\n").unwrap();
-    assert_bad_input(&clayloft(&["check", words.to_str().unwrap()]), &["words.gcode", "line 2"]);
+    assert_bad_input(
+        &clayloft(&["check", words.to_str().unwrap()]),
+        &["words.gcode", "line 2"],
+    );
     let empty = dir.path().join("empty.gcode");
     std::fs::write(&empty, "; nothing\n").unwrap();
-    assert_bad_input(&clayloft(&["check", empty.to_str().unwrap()]), &["no moves"]);
+    assert_bad_input(
+        &clayloft(&["check", empty.to_str().unwrap()]),
+        &["no moves"],
+    );
 }

@@ -1,1 +1,108 @@
-fn main() {}
+//! Speed targets of the core pipeline (issue: design → G-code for a 720-sample × 300-layer design
+//! in under 50 ms; G-code writing at 200 MB/s or more). Run with `cargo bench -p clayloft-core`.
+
+use std::hint::black_box;
+
+use clayloft_core::gcode::write_gcode;
+use clayloft_core::load::parse_design;
+use clayloft_core::pipeline::{PrintJob, Surface};
+use clayloft_core::toolpath::{PathPoint, Toolpath};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::{DVec2, DVec3};
+
+/// 720 samples per section, 150 mm at 0.5 mm layers = 300 layers, with a belly and a texture.
+const BIG_DESIGN: &str = r#"
+version = 1
+name = "benchmark vase"
+[printer]
+layer_height = 0.5
+[shape]
+height = 150.0
+samples = 720
+base_layers = 2
+[shape.lower]
+type = "circle"
+radius = 40.0
+[shape.upper]
+type = "rose"
+radius = 45.0
+amplitude = 8.0
+petals = 6
+[[control.vertical]]
+points = [[0.0, 0.0], [0.5, 12.0], [1.0, 0.0]]
+[texture]
+[texture.x]
+wave = "sine"
+period = 12
+amplitude = 0.8
+"#;
+
+fn pipeline(c: &mut Criterion) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench.gcode");
+    let mut g = c.benchmark_group("pipeline");
+    g.sample_size(20);
+    g.bench_function("design_to_gcode_file_720x300", |b| {
+        b.iter(|| {
+            let design = parse_design(BIG_DESIGN).unwrap();
+            let job = clayloft_core::run(&design).unwrap();
+            clayloft_core::atomic::write_atomically(&out, |w| write_gcode(&design, &job, w))
+                .unwrap();
+            black_box(job.toolpath.points.len())
+        })
+    });
+    g.finish();
+}
+
+/// A 1 M-point helix, written to memory: formatting speed, in bytes per second.
+fn gcode_writing(c: &mut Criterion) {
+    let design = parse_design(BIG_DESIGN).unwrap();
+    let n = 1_000_000;
+    let points = (0..n)
+        .map(|i| {
+            let a = i as f64 * 0.01;
+            PathPoint {
+                pos: DVec3::new(
+                    90.0 + 40.0 * a.cos(),
+                    95.0 + 40.0 * a.sin(),
+                    0.5 + i as f64 * 1e-4,
+                ),
+                thickness: 0.5,
+                flow: 1.0,
+                speed: 20.0,
+            }
+        })
+        .collect();
+    let job = PrintJob {
+        surface: Surface {
+            sections: Vec::new(),
+            layers: 300,
+            layer_pitch: 0.5,
+            center: DVec2::new(90.0, 95.0),
+            findings: Vec::new(),
+            metrics: Default::default(),
+        },
+        toolpath: Toolpath {
+            points,
+            base_points: 0,
+            revolutions: 1,
+        },
+    };
+    let mut buf = Vec::with_capacity(64 << 20);
+    write_gcode(&design, &job, &mut buf).unwrap();
+    let bytes = buf.len() as u64;
+    let mut g = c.benchmark_group("gcode");
+    g.sample_size(10);
+    g.throughput(Throughput::Bytes(bytes));
+    g.bench_function("write_1M_points", |b| {
+        b.iter(|| {
+            buf.clear();
+            write_gcode(&design, &job, &mut buf).unwrap();
+            black_box(buf.len())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, pipeline, gcode_writing);
+criterion_main!(benches);

@@ -104,12 +104,21 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
     for (idx, raw) in text.lines().enumerate() {
         let line = idx + 1;
         // Drop the comment and a host checksum (`*nn`).
-        let code = raw.split(';').next().unwrap_or("").split('*').next().unwrap_or("").trim();
+        let code = raw
+            .split(';')
+            .next()
+            .unwrap_or("")
+            .split('*')
+            .next()
+            .unwrap_or("")
+            .trim();
         if code.is_empty() {
             continue;
         }
         let mut words = code.split_whitespace();
-        let Some(mut cmd) = words.next() else { continue };
+        let Some(mut cmd) = words.next() else {
+            continue;
+        };
         // A line number (`N12 G1 …`) comes before the command.
         if cmd.starts_with(['N', 'n']) && cmd[1..].parse::<u64>().is_ok() {
             let Some(next) = words.next() else { continue };
@@ -179,7 +188,8 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
                 });
             }
             "G28" => pos = DVec3::ZERO,
-            c if c.starts_with(['G', 'M', 'T', 'N', 'F', 'S']) && c[1..].parse::<f64>().is_ok() => {}
+            c if c.starts_with(['G', 'M', 'T', 'N', 'F', 'S']) && c[1..].parse::<f64>().is_ok() => {
+            }
             other => {
                 return Err(GcodeError {
                     line,
@@ -447,7 +457,7 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
     for j in 0..v.len() {
         let p = v[j];
         // Every earlier segment is a candidate; the bead just laid is told apart below.
-        while pending + 1 <= j {
+        while pending < j {
             grid.insert(pending as u32, v[pending], v[pending + 1]);
             pending += 1;
         }

@@ -214,35 +214,54 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
     out.write_all(&buf)
 }
 
+/// Two-digit pairs "00" … "99", for writing integers two digits per division.
+const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+2021222324252627282930313233343536373839\
+4041424344454647484950515253545556575859\
+6061626364656667686970717273747576777879\
+8081828384858687888990919293949596979899";
+
+/// Appends the decimal digits of `n`, at least `min_digits` of them (zero-padded).
+#[inline]
+fn put_digits(buf: &mut Vec<u8>, mut n: u64, min_digits: usize) {
+    let mut tmp = [b'0'; 24];
+    let mut pos = tmp.len();
+    while n >= 100 {
+        let pair = (n % 100) as usize * 2;
+        n /= 100;
+        pos -= 2;
+        tmp[pos..pos + 2].copy_from_slice(&DIGIT_PAIRS[pair..pair + 2]);
+    }
+    if n >= 10 {
+        pos -= 2;
+        tmp[pos..pos + 2].copy_from_slice(&DIGIT_PAIRS[n as usize * 2..n as usize * 2 + 2]);
+    } else {
+        pos -= 1;
+        tmp[pos] = b'0' + n as u8;
+    }
+    let start = pos.min(tmp.len() - min_digits.min(tmp.len()));
+    buf.extend_from_slice(&tmp[start..]);
+}
+
 /// Appends `v` with exactly `decimals` digits after the point (none and no point for 0),
 /// rounded half away from zero; `-0` is written as `0`.
+#[inline]
 pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
-    let scale = 10u64.pow(decimals) as f64;
-    let scaled = (v.abs() * scale).round();
+    let pow = 10u64.pow(decimals);
+    let scaled = (v.abs() * pow as f64).round();
     if !scaled.is_finite() || scaled >= 9.0e18 {
         // Out of range for integer formatting (never for a real printer); fall back.
         buf.extend_from_slice(format!("{v:.*}", decimals as usize).as_bytes());
         return;
     }
-    let mut n = scaled as u64;
+    let n = scaled as u64;
     if v < 0.0 && n != 0 {
         buf.push(b'-');
     }
-    let mut digits = [0u8; 24];
-    let mut len = 0;
-    loop {
-        digits[len] = b'0' + (n % 10) as u8;
-        n /= 10;
-        len += 1;
-        if n == 0 && len > decimals as usize {
-            break;
-        }
-    }
-    for k in (0..len).rev() {
-        buf.push(digits[k]);
-        if k == decimals as usize && decimals > 0 {
-            buf.push(b'.');
-        }
+    put_digits(buf, n / pow, 1);
+    if decimals > 0 {
+        buf.push(b'.');
+        put_digits(buf, n % pow, decimals as usize);
     }
 }
 
@@ -266,6 +285,14 @@ mod tests {
         assert_eq!(fixed(3000.0, 0), "3000");
         assert_eq!(fixed(7.0, 1), "7.0");
         assert_eq!(fixed(1e300, 2).len(), format!("{:.2}", 1e300).len());
+        assert_eq!(fixed(123456.789, 3), "123456.789");
+        assert_eq!(fixed(0.00123, 5), "0.00123");
+        assert_eq!(fixed(99.9996, 3), "100.000");
+        for k in 0..2000 {
+            let v = (k as f64 - 1000.0) * 0.7391;
+            let written: f64 = fixed(v, 3).parse().unwrap();
+            assert!((written - v).abs() <= 0.0005 + 1e-9, "{v} -> {written}");
+        }
     }
 
     #[test]
@@ -330,8 +357,7 @@ mod tests {
         assert!(abs_text.contains("M82"));
         let last_e: f64 = abs_text
             .lines()
-            .filter(|l| l.starts_with("G1"))
-            .last()
+            .rfind(|l| l.starts_with("G1"))
             .map(|l| {
                 l.split(' ').find(|w| w.starts_with('E')).unwrap()[1..]
                     .parse()

@@ -156,10 +156,10 @@ fn field_offset(source: &str, field: &str) -> Option<usize> {
             _ => return best,
         };
         item = next;
-        for idx in indices
+        if let Some(idx) = indices
             .split(['[', ']'])
             .filter(|s| !s.is_empty())
-            .filter_map(|s| s.parse::<usize>().ok())
+            .find_map(|s| s.parse::<usize>().ok())
         {
             match item {
                 toml_edit::Item::ArrayOfTables(a) => {

@@ -48,6 +48,68 @@ pub fn displacement(tex: &Texture, i: usize, k: usize, layers: usize) -> f64 {
     }
 }
 
+/// Displaces every section along its outward normal by the texture, keeping the overhang limit.
+///
+/// For each column (sample index i) the amplitude is lowered by the largest factor `sᵢ ∈ [0, 1]`
+/// such that between any two consecutive sections `|b + sᵢ·Δd| ≤ Δz·tan_limit`, where b is the
+/// normal offset of the untextured wall and Δd the change of displacement. Returns one event
+/// per lowered column (amount = amplitude removed, mm), at the layer where the limit binds.
+pub fn apply_texture(
+    sections: &mut [crate::section::Section],
+    tex: &Texture,
+    tan_limit: f64,
+    enforce: bool,
+) -> Vec<crate::report::PointEvent> {
+    let layers = sections.len().saturating_sub(1);
+    let n = sections.first().map_or(0, |s| s.points.len());
+    let disp: Vec<Vec<f64>> = (0..sections.len())
+        .map(|k| (0..n).map(|i| displacement(tex, i, k, layers)).collect())
+        .collect();
+    let normals: Vec<Vec<glam::DVec2>> = sections.iter().map(|s| s.normals()).collect();
+    // Largest admissible scale per column, and the layer where it binds.
+    let mut scale = vec![(1.0_f64, 0_usize); n];
+    for k in 1..sections.len() {
+        for i in 0..n {
+            let (p, q) = (sections[k].points[i], sections[k - 1].points[i]);
+            let nb = normals[k - 1][i];
+            let b = (p.truncate() - q.truncate()).dot(nb);
+            let dd = disp[k][i] * normals[k][i].dot(nb) - disp[k - 1][i];
+            let limit = (p.z - q.z).max(0.0) * tan_limit;
+            let allowed = if dd > 1e-12 {
+                (limit - b) / dd
+            } else if dd < -1e-12 {
+                (limit + b) / -dd
+            } else {
+                1.0
+            };
+            let allowed = allowed.clamp(0.0, 1.0);
+            if allowed < scale[i].0 {
+                scale[i] = (allowed, k);
+            }
+        }
+    }
+    let mut events = Vec::new();
+    for (i, &(s, k)) in scale.iter().enumerate() {
+        if s < 1.0 - 1e-9 {
+            let amp = disp.iter().map(|d| d[i].abs()).fold(0.0, f64::max);
+            events.push(crate::report::PointEvent {
+                layer: k,
+                sample: i,
+                amount_mm: amp * (1.0 - s),
+            });
+        }
+    }
+    for (k, section) in sections.iter_mut().enumerate() {
+        for (i, p) in section.points.iter_mut().enumerate() {
+            let s = if enforce { scale[i].0 } else { 1.0 };
+            let shift = normals[k][i] * (disp[k][i] * s);
+            p.x += shift.x;
+            p.y += shift.y;
+        }
+    }
+    events
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,66 +186,4 @@ mod tests {
         assert!(displacement(&tex, 0, 60, 100).abs() < 1e-9);
         assert!((displacement(&tex, 2, 60, 100) - 1.0).abs() < 1e-9);
     }
-}
-
-/// Displaces every section along its outward normal by the texture, keeping the overhang limit.
-///
-/// For each column (sample index i) the amplitude is lowered by the largest factor `sᵢ ∈ [0, 1]`
-/// such that between any two consecutive sections `|b + sᵢ·Δd| ≤ Δz·tan_limit`, where b is the
-/// normal offset of the untextured wall and Δd the change of displacement. Returns one event
-/// per lowered column (amount = amplitude removed, mm), at the layer where the limit binds.
-pub fn apply_texture(
-    sections: &mut [crate::section::Section],
-    tex: &Texture,
-    tan_limit: f64,
-    enforce: bool,
-) -> Vec<crate::report::PointEvent> {
-    let layers = sections.len().saturating_sub(1);
-    let n = sections.first().map_or(0, |s| s.points.len());
-    let disp: Vec<Vec<f64>> = (0..sections.len())
-        .map(|k| (0..n).map(|i| displacement(tex, i, k, layers)).collect())
-        .collect();
-    let normals: Vec<Vec<glam::DVec2>> = sections.iter().map(|s| s.normals()).collect();
-    // Largest admissible scale per column, and the layer where it binds.
-    let mut scale = vec![(1.0_f64, 0_usize); n];
-    for k in 1..sections.len() {
-        for i in 0..n {
-            let (p, q) = (sections[k].points[i], sections[k - 1].points[i]);
-            let nb = normals[k - 1][i];
-            let b = (p.truncate() - q.truncate()).dot(nb);
-            let dd = disp[k][i] * normals[k][i].dot(nb) - disp[k - 1][i];
-            let limit = (p.z - q.z).max(0.0) * tan_limit;
-            let allowed = if dd > 1e-12 {
-                (limit - b) / dd
-            } else if dd < -1e-12 {
-                (limit + b) / -dd
-            } else {
-                1.0
-            };
-            let allowed = allowed.clamp(0.0, 1.0);
-            if allowed < scale[i].0 {
-                scale[i] = (allowed, k);
-            }
-        }
-    }
-    let mut events = Vec::new();
-    for (i, &(s, k)) in scale.iter().enumerate() {
-        if s < 1.0 - 1e-9 {
-            let amp = disp.iter().map(|d| d[i].abs()).fold(0.0, f64::max);
-            events.push(crate::report::PointEvent {
-                layer: k,
-                sample: i,
-                amount_mm: amp * (1.0 - s),
-            });
-        }
-    }
-    for (k, section) in sections.iter_mut().enumerate() {
-        for (i, p) in section.points.iter_mut().enumerate() {
-            let s = if enforce { scale[i].0 } else { 1.0 };
-            let shift = normals[k][i] * (disp[k][i] * s);
-            p.x += shift.x;
-            p.y += shift.y;
-        }
-    }
-    events
 }

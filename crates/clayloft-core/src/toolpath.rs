@@ -86,6 +86,8 @@ impl PathBuilder {
 }
 
 /// Builds the single continuous spiral path of a surface.
+// Index loops: sample i addresses several parallel arrays (sections, fractions, z below).
+#[allow(clippy::needless_range_loop)]
 pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, FieldError> {
     let p = &design.printer;
     let sections = &surface.sections;
@@ -114,7 +116,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
                     "the lower contour is not star-shaped around its centre, so a spiral base cannot fill it; use base_layers = 0",
                 )
             })?;
-        let outward = (base - layer) % 2 == 0;
+        let outward = (base - layer).is_multiple_of(2);
         let start = b.points.len();
         let ordered: Box<dyn Iterator<Item = &DVec3>> = if outward {
             Box::new(geometry.iter())
