@@ -126,23 +126,15 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
     } else {
         "shape"
     };
-    if lo.x < 0.0 || hi.x > p.bed_x {
-        return Err(FieldError::new(
-            field,
-            format!(
-                "the vessel spans x = {:.1} … {:.1} mm but the bed is 0 … {} mm (printer.bed_x); make it smaller or move it",
-                lo.x, hi.x, p.bed_x
-            ),
-        ));
-    }
-    if lo.y < 0.0 || hi.y > p.bed_y {
-        return Err(FieldError::new(
-            field,
-            format!(
-                "the vessel spans y = {:.1} … {:.1} mm but the bed is 0 … {} mm (printer.bed_y); make it smaller or move it",
-                lo.y, hi.y, p.bed_y
-            ),
-        ));
+    for (axis, lo, hi, size) in [("x", lo.x, hi.x, p.bed_x), ("y", lo.y, hi.y, p.bed_y)] {
+        if lo < 0.0 || hi > size {
+            return Err(FieldError::new(
+                field,
+                format!(
+                    "the vessel spans {axis} = {lo:.1} … {hi:.1} mm but the bed is 0 … {size} mm (printer.bed_{axis}); make it smaller or move it"
+                ),
+            ));
+        }
     }
     if top > p.max_z {
         return Err(FieldError::new(

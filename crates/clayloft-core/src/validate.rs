@@ -57,6 +57,17 @@ fn positive(field: &str, v: f64, unit: &str) -> Check {
     Ok(())
 }
 
+fn count_in(field: String, v: usize, lo: usize, hi: usize) -> Check {
+    if (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(FieldError::new(
+            field,
+            format!("{v} is outside {lo} ..= {hi}"),
+        ))
+    }
+}
+
 fn in_range(field: &str, v: f64, lo: f64, hi: f64, why: &str) -> Check {
     finite(field, v)?;
     if v < lo || v > hi {
@@ -328,12 +339,7 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             radius,
             corner_radius,
         } => {
-            if !(3..=1000).contains(sides) {
-                return Err(FieldError::new(
-                    fld("sides"),
-                    format!("{sides} is outside 3 ..= 1000"),
-                ));
-            }
+            count_in(fld("sides"), *sides, 3, 1000)?;
             positive(&fld("radius"), *radius, "mm")?;
             let inradius = radius * (std::f64::consts::PI / *sides as f64).cos();
             in_range(
@@ -349,12 +355,7 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             outer_radius,
             inner_radius,
         } => {
-            if !(2..=1000).contains(points) {
-                return Err(FieldError::new(
-                    fld("points"),
-                    format!("{points} is outside 2 ..= 1000"),
-                ));
-            }
+            count_in(fld("points"), *points, 2, 1000)?;
             positive(&fld("outer_radius"), *outer_radius, "mm")?;
             positive(&fld("inner_radius"), *inner_radius, "mm")?;
             if inner_radius >= outer_radius {
@@ -380,12 +381,7 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
                     ),
                 ));
             }
-            if !(1..=500).contains(petals) {
-                return Err(FieldError::new(
-                    fld("petals"),
-                    format!("{petals} is outside 1 ..= 500"),
-                ));
-            }
+            count_in(fld("petals"), *petals, 1, 500)?;
             Ok(())
         }
         ContourSpec::Spline { points } => {
