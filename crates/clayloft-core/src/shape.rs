@@ -254,3 +254,77 @@ impl ShapeModel {
         worst
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::load::parse_design;
+    use crate::pipeline::build_surface;
+
+    fn tilted(dz: f64, enforce: bool) -> crate::design::Design {
+        parse_design(&format!(
+            "version = 1\n[shape]\nheight = 80.0\nsamples = 120\nbase_layers = 0\n[shape.lower]\ntype = \"circle\"\nradius = 35.0\n\
+             [shape.upper]\ntype = \"circle\"\nradius = 35.0\n[[control.horizontal]]\nat = 1.0\nreach = 0.5\n\
+             points = [[90.0, {dz}], [270.0, -{dz}]]\n[constraints]\nenforce = {enforce}\n"
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn tilted_layers_get_more_layers_not_thicker_ones() {
+        let s = build_surface(&tilted(10.0, true)).unwrap();
+        assert!(s.layers > 80, "{}", s.layers);
+        assert!(
+            s.metrics.max_layer_height <= 1.0 + 1e-9,
+            "{}",
+            s.metrics.max_layer_height
+        );
+        assert!(
+            s.metrics.min_layer_height >= 0.25 - 1e-9,
+            "{}",
+            s.metrics.min_layer_height
+        );
+        assert!(
+            (s.metrics.max_layer_z_range - 20.0).abs() < 0.1,
+            "{}",
+            s.metrics.max_layer_z_range
+        );
+        assert!(s.findings.is_empty());
+    }
+
+    #[test]
+    fn a_tilt_taller_than_the_nozzle_is_scaled_down_and_reported() {
+        // ±20 mm: a 40 mm z range in the top layer, more than the 30 mm nozzle.
+        let s = build_surface(&tilted(20.0, true)).unwrap();
+        assert!(
+            s.metrics.max_layer_z_range <= 30.0,
+            "{}",
+            s.metrics.max_layer_z_range
+        );
+        assert_eq!(s.findings.len(), 1);
+        assert!(
+            s.findings[0].corrected && s.findings[0].message.contains("nozzle length"),
+            "{}",
+            s.findings[0]
+        );
+        let reported = build_surface(&tilted(20.0, false)).unwrap();
+        assert!(!reported.findings[0].corrected);
+        assert!((reported.metrics.max_layer_z_range - 40.0).abs() < 0.1);
+    }
+
+    #[test]
+    fn local_vertical_line_moves_only_its_angles_and_span() {
+        let d = parse_design(
+            "version = 1\n[shape]\nheight = 50.0\nsamples = 360\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n\
+             [shape.upper]\ntype = \"circle\"\nradius = 30.0\n[[control.vertical]]\n\
+             points = [[0.0, 0.0], [0.4, 0.0], [0.6, 5.0], [0.8, 0.0], [1.0, 0.0]]\nangle = 90.0\nwidth = 60.0\n",
+        )
+        .unwrap();
+        let s = build_surface(&d).unwrap();
+        let c = s.center;
+        let r = |k: usize, deg: usize| (s.sections[k].points[deg].truncate() - c).length();
+        assert!((r(30, 90) - 35.0).abs() < 1e-6, "{}", r(30, 90));
+        assert!((r(30, 105) - 32.5).abs() < 1e-4, "{}", r(30, 105));
+        assert!((r(30, 270) - 30.0).abs() < 1e-6);
+        assert!((r(10, 90) - 30.0).abs() < 1e-6);
+    }
+}
