@@ -285,6 +285,17 @@ struct Tally {
 }
 
 impl Tally {
+    /// The violation this tally records, if any.
+    fn into_violation(self, what: &'static str, detail: String) -> Option<Violation> {
+        (self.count > 0).then_some(Violation {
+            what,
+            count: self.count,
+            worst: self.worst,
+            first_line: self.first_line,
+            detail,
+        })
+    }
+
     fn add(&mut self, value: f64, line: usize) {
         if self.count == 0 {
             self.first_line = line;
@@ -347,36 +358,21 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
         report.bounds_min = lo;
         report.bounds_max = hi;
     }
-    if outside.count > 0 {
-        report.violations.push(Violation {
-            what: "outside the machine",
-            count: outside.count,
-            worst: 0.0,
-            first_line: outside.first_line,
-            detail: format!(
-                "bed 0 … {} × 0 … {} mm, height 0 … {} mm",
-                limits.bed_x, limits.bed_y, limits.max_z
+    report.violations.extend(
+        [
+            outside.into_violation(
+                "outside the machine",
+                format!("bed 0 … {} × 0 … {} mm, height 0 … {} mm", limits.bed_x, limits.bed_y, limits.max_z),
             ),
-        });
-    }
-    if travel.count > 0 {
-        report.violations.push(Violation {
-            what: "not one continuous path",
-            count: travel.count,
-            worst: travel.worst,
-            first_line: travel.first_line,
-            detail: "moves without extrusion between the first and last extruding move (worst = longest, mm)".into(),
-        });
-    }
-    if retract.count > 0 {
-        report.violations.push(Violation {
-            what: "retraction",
-            count: retract.count,
-            worst: retract.worst,
-            first_line: retract.first_line,
-            detail: "clay printing allows no retraction (worst = mm of E)".into(),
-        });
-    }
+            travel.into_violation(
+                "not one continuous path",
+                "moves without extrusion between the first and last extruding move (worst = longest, mm)".into(),
+            ),
+            retract.into_violation("retraction", "clay printing allows no retraction (worst = mm of E)".into()),
+        ]
+        .into_iter()
+        .flatten(),
+    );
     if let (Some(a), Some(b)) = (first_ext, last_ext) {
         let mut vertices = Vec::with_capacity(b - a + 2);
         let mut lines = Vec::with_capacity(b - a + 2);
@@ -568,15 +564,7 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
         report.min_layer_height = 0.0;
     }
     let mut push = |t: Tally, what: &'static str, detail: String| {
-        if t.count > 0 {
-            report.violations.push(Violation {
-                what,
-                count: t.count,
-                worst: t.worst,
-                first_line: t.first_line,
-                detail,
-            });
-        }
+        report.violations.extend(t.into_violation(what, detail))
     };
     push(
         thin,

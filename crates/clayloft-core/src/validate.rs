@@ -394,21 +394,16 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             if points.len() > MAX_SAMPLES {
                 return Err(FieldError::new(fld("points"), "too many points"));
             }
-            for (k, [x, y]) in points.iter().copied().enumerate() {
-                in_range(
-                    &format!("{f}.points[{k}]"),
-                    x,
-                    -MAX_LENGTH,
-                    MAX_LENGTH,
-                    "mm",
-                )?;
-                in_range(
-                    &format!("{f}.points[{k}]"),
-                    y,
-                    -MAX_LENGTH,
-                    MAX_LENGTH,
-                    "mm",
-                )?;
+            for (k, xy) in points.iter().enumerate() {
+                for v in xy {
+                    in_range(
+                        &format!("{f}.points[{k}]"),
+                        *v,
+                        -MAX_LENGTH,
+                        MAX_LENGTH,
+                        "mm",
+                    )?;
+                }
             }
             Ok(())
         }
