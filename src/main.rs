@@ -68,7 +68,7 @@ fn main() -> ExitCode {
         Some(Command::Gcode { design, out }) => gcode(&design, &out),
         Some(Command::Stl { design, out, ascii }) => stl(&design, &out, ascii),
         Some(Command::Check { gcode, design }) => check(&gcode, design.as_deref()),
-        None => overview(cli.design.as_deref().unwrap_or(Path::new(DEFAULT_DESIGN))),
+        None => overview(&cli.design.unwrap_or_else(default_design)),
     };
     match result {
         Ok(code) => code,
@@ -76,6 +76,17 @@ fn main() -> ExitCode {
             eprintln!("error: {message}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// The default design: from the current folder when run in the repository, else from the source
+/// tree this binary was built from.
+fn default_design() -> PathBuf {
+    let local = PathBuf::from(DEFAULT_DESIGN);
+    if local.exists() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_DESIGN)
     }
 }
 
