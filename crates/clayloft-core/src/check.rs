@@ -225,7 +225,25 @@ pub struct CheckReport {
     pub bounds_min: DVec3,
     pub bounds_max: DVec3,
     pub violations: Vec<Violation>,
+    /// Every point that broke the overhang, support or collision limit, in path order.
+    pub events: Vec<PathEvent>,
 }
+
+/// One point of the path that broke a limit: where (G-code line, or point index for
+/// [`check_path`]), which limit and by how much (degrees or mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathEvent {
+    pub line: usize,
+    pub what: &'static str,
+    pub value: f64,
+}
+
+/// What the nozzle holder hitting the printed part is called in reports.
+pub const COLLISION: &str = "nozzle collision";
+/// What a point leaning past the overhang limit is called in reports.
+pub const OVERHANG: &str = "overhang";
+/// What a point with nothing under it is called in reports.
+pub const UNSUPPORTED: &str = "unsupported";
 
 impl CheckReport {
     pub fn ok(&self) -> bool {
@@ -388,6 +406,22 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
     Ok(report)
 }
 
+/// Measures an extruding path (layer heights, overhang, support, holder collision) given as
+/// points; the `line` of each event and violation is the point index. The app's nozzle replay
+/// uses this on the toolpath so that it flags exactly what `clayloft check` would.
+pub fn check_path(points: &[DVec3], limits: &Limits) -> CheckReport {
+    let mut report = CheckReport {
+        moves: points.len(),
+        extruding_moves: points.len().saturating_sub(1),
+        ..Default::default()
+    };
+    if points.len() >= 2 {
+        let lines: Vec<usize> = (0..points.len()).collect();
+        measure_layers(points, &lines, limits, &mut report);
+    }
+    report
+}
+
 /// Spatial hash of path segments in (x, y, z-band) cells.
 struct SegmentGrid {
     cell: f64,
@@ -462,6 +496,11 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
         }
         if running_max_z - p.z > limits.nozzle_length + 1e-6 {
             collide.add(running_max_z - p.z, lines[j]);
+            report.events.push(PathEvent {
+                line: lines[j],
+                what: COLLISION,
+                value: running_max_z - p.z,
+            });
         }
         running_max_z = running_max_z.max(p.z);
         if j == 0 {
@@ -544,6 +583,11 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
             (p.z, 0.0) // on the bed
         } else {
             unsupported.add(p.z, lines[j]);
+            report.events.push(PathEvent {
+                line: lines[j],
+                what: UNSUPPORTED,
+                value: p.z,
+            });
             continue;
         };
         report.min_layer_height = report.min_layer_height.min(height);
@@ -558,6 +602,11 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
         report.max_overhang_deg = report.max_overhang_deg.max(angle);
         if angle > limits.max_overhang_deg + angle_tol {
             lean.add(angle, lines[j]);
+            report.events.push(PathEvent {
+                line: lines[j],
+                what: OVERHANG,
+                value: angle,
+            });
         }
     }
     if !report.min_layer_height.is_finite() {
@@ -584,7 +633,7 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
     );
     push(
         lean,
-        "overhang",
+        OVERHANG,
         format!(
             "wall leans past {}° (worst = degrees)",
             limits.max_overhang_deg
@@ -592,12 +641,12 @@ fn measure_layers(v: &[DVec3], lines: &[usize], limits: &Limits, report: &mut Ch
     );
     push(
         unsupported,
-        "unsupported",
+        UNSUPPORTED,
         format!("no printed layer within {radius:.1} mm below (worst = z, mm)"),
     );
     push(
         collide,
-        "nozzle collision",
+        COLLISION,
         format!(
             "printed part rises above the holder, nozzle_length {} mm (worst = mm)",
             limits.nozzle_length
@@ -636,6 +685,45 @@ mod tests {
             );
         }
         s
+    }
+
+    #[test]
+    fn check_path_flags_each_point_like_the_gcode_checker() {
+        let text = helix(1.5, 10, 1.0);
+        let from_gcode = check_gcode(&text, &limits()).unwrap();
+        let (moves, start) = parse_moves(&text).unwrap();
+        let points: Vec<DVec3> = std::iter::once(start)
+            .chain(moves.iter().map(|m| m.to))
+            .collect();
+        let r = check_path(&points[1..], &limits());
+        let lean = |r: &CheckReport| {
+            r.violations
+                .iter()
+                .find(|v| v.what == OVERHANG)
+                .map(|v| v.count)
+        };
+        assert!(lean(&r).unwrap() > 0);
+        assert_eq!(lean(&r), lean(&from_gcode));
+        let overhangs: Vec<&PathEvent> = r.events.iter().filter(|e| e.what == OVERHANG).collect();
+        assert_eq!(overhangs.len(), lean(&r).unwrap());
+        assert!(overhangs.windows(2).all(|w| w[0].line < w[1].line));
+        assert!(overhangs.iter().all(|e| e.value > 45.0));
+        // A point far below a tall printed part is a holder collision at that index.
+        let mut tower: Vec<DVec3> = (0..200)
+            .map(|k| {
+                DVec3::new(
+                    90.0 + 30.0 * (k as f64 * 0.1).cos(),
+                    95.0 + 30.0 * (k as f64 * 0.1).sin(),
+                    1.0 + k as f64 * 0.2,
+                )
+            })
+            .collect();
+        tower.push(DVec3::new(90.0, 95.0, 1.0));
+        let r = check_path(&tower, &limits());
+        let hit: Vec<&PathEvent> = r.events.iter().filter(|e| e.what == COLLISION).collect();
+        assert_eq!(hit.len(), 1);
+        assert_eq!(hit[0].line, 200);
+        assert!((hit[0].value - 39.8).abs() < 1e-9);
     }
 
     #[test]

@@ -61,6 +61,32 @@ pub fn clamp_overhang(
     events
 }
 
+/// Lean of the wall from vertical at point i of section k (k ≥ 1), degrees:
+/// `atan(|(pₖ − pₖ₋₁)·n| / Δz)` with n the XY normal of section k − 1.
+#[inline]
+fn lean_deg(p: glam::DVec3, q: glam::DVec3, n: DVec2) -> f64 {
+    let dz = p.z - q.z;
+    let off = (p.truncate() - q.truncate()).dot(n).abs();
+    off.atan2(dz.max(1e-9)).to_degrees()
+}
+
+/// Lean from vertical of every point, section-major (`k·n + i`), degrees; section 0 (on the bed)
+/// leans 0. The preview colours the wall by these.
+pub fn point_leans_deg(sections: &[Section]) -> Vec<f32> {
+    let mut out = Vec::with_capacity(sections.iter().map(|s| s.points.len()).sum());
+    if let Some(first) = sections.first() {
+        out.resize(first.points.len(), 0.0);
+    }
+    for k in 1..sections.len() {
+        let prev = &sections[k - 1];
+        let normals = prev.normals();
+        for (i, p) in sections[k].points.iter().enumerate() {
+            out.push(lean_deg(*p, prev.points[i], normals[i]) as f32);
+        }
+    }
+    out
+}
+
 /// Largest lean, z ranges and layer heights of a surface.
 pub fn measure(sections: &[Section]) -> SurfaceMetrics {
     let mut m = SurfaceMetrics {
@@ -78,8 +104,7 @@ pub fn measure(sections: &[Section]) -> SurfaceMetrics {
                 let dz = p.z - q.z;
                 m.min_layer_height = m.min_layer_height.min(dz);
                 m.max_layer_height = m.max_layer_height.max(dz);
-                let off = (p.truncate() - q.truncate()).dot(normals[i]).abs();
-                m.max_overhang_deg = m.max_overhang_deg.max(off.atan2(dz.max(1e-9)).to_degrees());
+                m.max_overhang_deg = m.max_overhang_deg.max(lean_deg(*p, q, normals[i]));
             }
         }
     }
@@ -118,6 +143,11 @@ mod tests {
         // First correction removes 1 mm; later ones more as the design runs away.
         assert!((ev[0].amount_mm - 1.0).abs() < 1e-3);
         let after = measure(&s);
+        let leans = point_leans_deg(&s);
+        assert_eq!(leans.len(), 5 * 360);
+        assert!(leans[..360].iter().all(|a| *a == 0.0));
+        let max = leans.iter().cloned().fold(0.0f32, f32::max) as f64;
+        assert!((max - after.max_overhang_deg).abs() < 1e-3);
         assert!(
             after.max_overhang_deg <= 45.0 + 1e-6,
             "{}",

@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 
-use crate::align::{align, anchor};
+use crate::align::anchor;
 use crate::contour::{Contour, ContourError, DENSE_POINTS};
 use crate::design::{ContourSpec, Design};
 use crate::sample::{correspond, sample_from_anchor};
@@ -23,17 +23,40 @@ pub struct LoftInput {
     pub angles: Vec<f64>,
 }
 
+/// One contour of the design, aligned and sampled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampledContour {
+    /// Samples by equal arc length from the anchor, on the bed coordinates.
+    pub samples: Vec<DVec2>,
+    /// Translation that alignment applied to the contour as specified (spec → bed coordinates).
+    pub offset: DVec2,
+}
+
 /// Builds, aligns and samples one contour of the design.
+pub fn sample_contour(
+    spec: &ContourSpec,
+    field: &str,
+    center: DVec2,
+    samples: usize,
+) -> Result<SampledContour, FieldError> {
+    let contour = Contour::from_spec(spec, DENSE_POINTS.max(4 * samples))
+        .map_err(|e: ContourError| FieldError::new(field, e.to_string()))?;
+    let offset = center - anchor(&contour);
+    let aligned = contour.translated(offset);
+    Ok(SampledContour {
+        samples: sample_from_anchor(&aligned, anchor(&aligned), samples),
+        offset,
+    })
+}
+
+/// The samples of one contour of the design (see [`sample_contour`]).
 pub fn sampled_contour(
     spec: &ContourSpec,
     field: &str,
     center: DVec2,
     samples: usize,
 ) -> Result<Vec<DVec2>, FieldError> {
-    let contour = Contour::from_spec(spec, DENSE_POINTS.max(4 * samples))
-        .map_err(|e: ContourError| FieldError::new(field, e.to_string()))?;
-    let aligned = align(&contour, center);
-    Ok(sample_from_anchor(&aligned, anchor(&aligned), samples))
+    sample_contour(spec, field, center, samples).map(|c| c.samples)
 }
 
 impl LoftInput {

@@ -57,9 +57,21 @@ pub fn correct_shape(design: &Design, sections: &mut [Section], from: usize) -> 
 /// Builds the corrected, textured surface of a design.
 pub fn build_surface(design: &Design) -> Result<Surface, FieldError> {
     let loft = LoftInput::from_design(design)?;
-    let center = loft.center;
-    let (model, mut findings) = ShapeModel::new(design, loft);
-    let mut sections: Vec<Section> = (0..=model.layers).map(|k| model.section(k)).collect();
+    let (model, findings) = ShapeModel::new(design, loft);
+    let sections: Vec<Section> = (0..=model.layers).map(|k| model.section(k)).collect();
+    finish_surface(design, &model, sections, findings)
+}
+
+/// Stages 4–5 on the shaped sections `model.section(k)`: overhang correction, texture, metrics
+/// and the fit on the machine. The app calls this after recomputing only the sections an edit
+/// touched; `findings` are the layer plan's (from [`ShapeModel::new`]).
+pub fn finish_surface(
+    design: &Design,
+    model: &ShapeModel,
+    mut sections: Vec<Section>,
+    mut findings: Vec<Finding>,
+) -> Result<Surface, FieldError> {
+    let center = model.loft.center;
     findings.extend(correct_shape(design, &mut sections, 1));
     if let Some(tex) = &design.texture {
         let enforce = design.constraints.enforce;
