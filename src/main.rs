@@ -1,6 +1,10 @@
-//! `clayloft`: the command line (SPEC §7). Thin: every piece of work is a call into
-//! `clayloft-core`; this file only parses arguments, prints summaries and maps errors to exit
-//! codes (0 = done, 1 = check found violations, 2 = bad input).
+//! `clayloft`: the application (SPEC §8, [`app`]) and the command line (SPEC §7). Thin: every
+//! piece of work is a call into `clayloft-core` or a plugin; this file only parses arguments,
+//! prints summaries and maps errors to exit codes (0 = done, 1 = check found violations,
+//! 2 = bad input).
+
+mod app;
+mod screenshot;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -23,7 +27,7 @@ const DEFAULT_DESIGN: &str = "assets/designs/petal-vase.toml";
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Design file to open (default: the petal vase).
+    /// Design file to open in the editor (default: the petal vase).
     design: Option<PathBuf>,
 }
 
@@ -43,6 +47,21 @@ enum Command {
         /// Write ASCII STL instead of binary.
         #[arg(long)]
         ascii: bool,
+    },
+    /// Print what a design makes (layers, path, time, corrections) without opening a window.
+    Info { design: Option<PathBuf> },
+    /// Render the editor's view of a design to a PNG and exit (works under xvfb-run with Mesa).
+    Screenshot {
+        design: Option<PathBuf>,
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Put the replayed nozzle at this fraction (0–1) of the print.
+        #[arg(long)]
+        progress: Option<f64>,
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        #[arg(long, default_value_t = 720)]
+        height: u32,
     },
     /// Re-measure a G-code file against the printer limits (exit 0 = all hold, 1 = violations).
     Check {
@@ -68,7 +87,21 @@ fn main() -> ExitCode {
         Some(Command::Gcode { design, out }) => gcode(&design, &out),
         Some(Command::Stl { design, out, ascii }) => stl(&design, &out, ascii),
         Some(Command::Check { gcode, design }) => check(&gcode, design.as_deref()),
-        None => overview(&cli.design.unwrap_or_else(default_design)),
+        Some(Command::Info { design }) => overview(&design.unwrap_or_else(default_design)),
+        Some(Command::Screenshot {
+            design,
+            out,
+            progress,
+            width,
+            height,
+        }) => shoot(
+            design.unwrap_or_else(default_design),
+            out,
+            progress,
+            width,
+            height,
+        ),
+        None => editor(cli.design.unwrap_or_else(default_design)),
     };
     match result {
         Ok(code) => code,
@@ -194,11 +227,47 @@ fn check(path: &Path, design: Option<&Path>) -> Result<ExitCode, Failure> {
     })
 }
 
-/// `clayloft [DESIGN]`: the interactive application is not built yet (see the README); until it
-/// is, show what the design would print.
+/// `clayloft info [DESIGN]`: what the design would print.
 fn overview(design: &Path) -> Result<ExitCode, Failure> {
     let (loaded, job) = job_of(design)?;
     print_summary(&loaded, &job);
-    println!("(the interactive 3D editor is not built yet; `clayloft gcode` writes the print)");
     Ok(ExitCode::SUCCESS)
+}
+
+/// `clayloft [DESIGN]`: the editor. The design is read first, so a bad file is a one-line error
+/// (exit 2) rather than an empty window.
+fn editor(design: PathBuf) -> Result<ExitCode, Failure> {
+    let loaded = load_design(&design)?;
+    Ok(app::run(loaded.design, loaded.path, None))
+}
+
+/// `clayloft screenshot [DESIGN] -o OUT.png [--progress F]`.
+fn shoot(
+    design: PathBuf,
+    out: PathBuf,
+    progress: Option<f64>,
+    width: u32,
+    height: u32,
+) -> Result<ExitCode, Failure> {
+    if let Some(f) = progress
+        && !(0.0..=1.0).contains(&f)
+    {
+        return Err(Failure(format!("--progress {f}: must lie in 0 … 1")));
+    }
+    if !(64..=8192).contains(&width) || !(64..=8192).contains(&height) {
+        return Err(Failure(format!(
+            "{width} × {height}: the picture must be 64 … 8192 pixels each way"
+        )));
+    }
+    let (loaded, _job) = job_of(&design)?;
+    let req = screenshot::ScreenshotRequest {
+        out,
+        progress,
+        width,
+        height,
+        settle_frames: 60,
+        settle_time: std::time::Duration::from_secs(4),
+        timeout: std::time::Duration::from_secs(300),
+    };
+    Ok(app::run(loaded.design, loaded.path, Some(req)))
 }

@@ -251,8 +251,8 @@ fn stl_is_a_closed_two_manifold() {
 }
 
 #[test]
-fn default_command_summarises_the_default_design() {
-    let out = clayloft(&[]);
+fn info_summarises_the_default_design() {
+    let out = clayloft(&["info"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("petal vase"));
 }
@@ -401,4 +401,28 @@ fn check_rejects_files_that_are_not_gcode() {
         &clayloft(&["check", empty.to_str().unwrap()]),
         &["no moves"],
     );
+}
+
+#[test]
+fn editor_and_screenshot_reject_bad_input_before_opening_a_window() {
+    let out = clayloft(&["/nonexistent/vase.toml"]);
+    assert_bad_input(&out, &["/nonexistent/vase.toml"]);
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("shot.png");
+    let out = clayloft(&[
+        "screenshot",
+        "-o",
+        png.to_str().unwrap(),
+        "--progress",
+        "1.5",
+    ]);
+    assert_bad_input(&out, &["--progress", "0 … 1"]);
+    let out = clayloft(&[
+        "screenshot",
+        "/nonexistent/vase.toml",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_bad_input(&out, &["/nonexistent/vase.toml"]);
+    assert!(!png.exists());
 }

@@ -1,0 +1,232 @@
+//! The move gizmo: three axis arrows (design x red, y green, z blue) and a plane square (the bed
+//! plane) on the selected handle. Dragging an arrow moves the handle only along that axis;
+//! dragging the square moves it parallel to the bed. Built on picking like the handles (the
+//! transform-gizmo crate needs a newer compiler than ours).
+
+use bevy::picking::Pickable;
+use bevy::prelude::*;
+use clayloft_model::coords::{from_world, to_world};
+use clayloft_model::handles::{HandleFrame, HandleRole, handle_frame, set_handle};
+use clayloft_model::*;
+
+use crate::drag::{ActiveDrag, Selection, contour_offsets};
+use crate::history::EditInProgress;
+use crate::ray::{ray_axis, ray_plane};
+
+/// Length of an arrow, mm.
+const ARROW: f32 = 22.0;
+
+/// The gizmo's root entity, placed on the selected handle.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct MoveGizmo;
+
+/// One grabbable part of the gizmo.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub enum GizmoPart {
+    /// Move along this world direction.
+    Axis(Vec3),
+    /// Move in the horizontal (bed) plane.
+    BedPlane,
+}
+
+/// A gizmo drag under way.
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct GizmoDrag(Option<GizmoDragState>);
+
+#[derive(Debug, Clone, Copy)]
+struct GizmoDragState {
+    part: GizmoPart,
+    role: HandleRole,
+    frame: HandleFrame,
+    /// Handle position at the start (world).
+    start: Vec3,
+    /// Axis parameter or plane point where the pointer grabbed.
+    grab_s: f32,
+    grab_point: Vec3,
+}
+
+pub(crate) fn plugin(app: &mut App) {
+    app.init_resource::<GizmoDrag>()
+        .add_systems(Startup, spawn_gizmo)
+        .add_systems(Update, follow_selection.in_set(ModelSystems::View));
+}
+
+fn spawn_gizmo(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let mut mat = |c: Color| {
+        materials.add(StandardMaterial {
+            base_color: c,
+            unlit: true,
+            ..default()
+        })
+    };
+    let parts = [
+        (
+            GizmoPart::Axis(to_world(bevy::math::DVec3::X)),
+            mat(Color::srgb(0.95, 0.2, 0.2)),
+        ),
+        (
+            GizmoPart::Axis(to_world(bevy::math::DVec3::Y)),
+            mat(Color::srgb(0.2, 0.9, 0.3)),
+        ),
+        (
+            GizmoPart::Axis(to_world(bevy::math::DVec3::Z)),
+            mat(Color::srgb(0.25, 0.45, 1.0)),
+        ),
+        (GizmoPart::BedPlane, mat(Color::srgba(0.95, 0.9, 0.3, 0.8))),
+    ];
+    let shaft = meshes.add(Cuboid::new(1.2, 1.2, ARROW));
+    let square = meshes.add(Cuboid::new(7.0, 0.6, 7.0));
+    commands
+        .spawn((
+            MoveGizmo,
+            Transform::default(),
+            Visibility::Hidden,
+            Name::new("move gizmo"),
+        ))
+        .with_children(|root| {
+            for (part, material) in parts {
+                let (mesh, transform) = match part {
+                    GizmoPart::Axis(a) => (
+                        shaft.clone(),
+                        Transform::from_translation(a * (ARROW / 2.0 + 3.0))
+                            .looking_to(a, if a.y.abs() > 0.9 { Vec3::X } else { Vec3::Y }),
+                    ),
+                    GizmoPart::BedPlane => (square.clone(), Transform::from_xyz(8.0, 0.0, -8.0)),
+                };
+                root.spawn((
+                    part,
+                    Mesh3d(mesh),
+                    MeshMaterial3d(material),
+                    transform,
+                    Pickable::default(),
+                ))
+                .observe(start_gizmo_drag)
+                .observe(gizmo_drag)
+                .observe(end_gizmo_drag);
+            }
+        });
+}
+
+fn follow_selection(
+    selection: Res<Selection>,
+    handles: Query<(&EditHandle, &Transform), Without<MoveGizmo>>,
+    mut gizmo: Single<(&mut Transform, &mut Visibility), With<MoveGizmo>>,
+) {
+    let placed = selection
+        .0
+        .and_then(|role| handles.iter().find(|(h, _)| h.0 == role))
+        .map(|(_, t)| t.translation);
+    let (t, v) = &mut *gizmo;
+    match placed {
+        Some(p) => {
+            t.translation = p;
+            **v = Visibility::Inherited;
+        }
+        None => **v = Visibility::Hidden,
+    }
+}
+
+fn pointer_ray(
+    cams: &Query<(&Camera, &GlobalTransform), With<Camera3d>>,
+    at: Vec2,
+) -> Option<(Vec3, Vec3)> {
+    let (cam, t) = cams.iter().next()?;
+    let ray = cam.viewport_to_world(t, at).ok()?;
+    Some((ray.origin, *ray.direction))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn start_gizmo_drag(
+    ev: On<Pointer<DragStart>>,
+    parts: Query<&GizmoPart>,
+    selection: Res<Selection>,
+    handles: Query<(&EditHandle, &Transform)>,
+    doc: Option<Res<DesignDoc>>,
+    cache: Res<ModelCache>,
+    contours: Query<(&ContourRole, &ContourSamples)>,
+    cams: Query<(&Camera, &GlobalTransform), With<Camera3d>>,
+    mut drag: ResMut<GizmoDrag>,
+    mut handle_drag: ResMut<ActiveDrag>,
+    mut busy: ResMut<EditInProgress>,
+) {
+    let (Ok(part), Some(role), Some(doc)) = (parts.get(ev.entity), selection.0, doc) else {
+        return;
+    };
+    let Some((_, t)) = handles.iter().find(|(h, _)| h.0 == role) else {
+        return;
+    };
+    let Some(frame) = handle_frame(role, &doc.design, &cache, &contour_offsets(&contours)) else {
+        return;
+    };
+    let Some((o, d)) = pointer_ray(&cams, ev.pointer_location.position) else {
+        return;
+    };
+    let start = t.translation;
+    let (grab_s, grab_point) = match part {
+        GizmoPart::Axis(a) => (ray_axis(o, d, start, *a).unwrap_or(0.0), start),
+        GizmoPart::BedPlane => (
+            0.0,
+            ray_plane(o, d, start, Vec3::Y).map_or(start, |t| o + d * t),
+        ),
+    };
+    drag.0 = Some(GizmoDragState {
+        part: *part,
+        role,
+        frame,
+        start,
+        grab_s,
+        grab_point,
+    });
+    // The camera stays still while the gizmo is held (same gate as handle drags).
+    handle_drag.0 = Some(crate::drag::DragState {
+        role,
+        frame,
+        plane_point: start,
+        plane_normal: Vec3::Y,
+        grab: Vec3::ZERO,
+    });
+    busy.0 = true;
+}
+
+fn gizmo_drag(
+    ev: On<Pointer<Drag>>,
+    drag: Res<GizmoDrag>,
+    cams: Query<(&Camera, &GlobalTransform), With<Camera3d>>,
+    doc: Option<ResMut<DesignDoc>>,
+) {
+    let (Some(s), Some(mut doc)) = (drag.0, doc) else {
+        return;
+    };
+    let Some((o, d)) = pointer_ray(&cams, ev.pointer_location.position) else {
+        return;
+    };
+    let target = match s.part {
+        GizmoPart::Axis(a) => match ray_axis(o, d, s.start, a) {
+            Some(sv) => s.start + a * (sv - s.grab_s),
+            None => return,
+        },
+        GizmoPart::BedPlane => match ray_plane(o, d, s.grab_point, Vec3::Y) {
+            Some(t) => s.start + (o + d * t - s.grab_point),
+            None => return,
+        },
+    };
+    let mut edited = doc.design.clone();
+    if set_handle(s.role, &mut edited, &s.frame, from_world(target)) {
+        doc.design = edited;
+    }
+}
+
+fn end_gizmo_drag(
+    _ev: On<Pointer<DragEnd>>,
+    mut drag: ResMut<GizmoDrag>,
+    mut handle_drag: ResMut<ActiveDrag>,
+    mut busy: ResMut<EditInProgress>,
+) {
+    drag.0 = None;
+    handle_drag.0 = None;
+    busy.0 = false;
+}

@@ -1,0 +1,392 @@
+//! Files in the app: open and save design files (SPEC §6; a saved file loads back identical),
+//! export G-code and STL with the same writers as the command line, and autosave so that no edit
+//! is lost if the program is killed.
+//!
+//! Autosave: after every change the design is written (atomically) to the autosave file of the
+//! document — `<autosave dir>/<file stem>.autosave.toml`, the directory being
+//! `$CLAYLOFT_AUTOSAVE_DIR`, else `$XDG_STATE_HOME/clayloft`, else `~/.local/state/clayloft`.
+//! Opening a design whose autosave differs from it restores the autosave and says so; saving
+//! removes it.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use bevy::prelude::*;
+use clayloft_core::Design;
+use clayloft_core::atomic::write_atomically;
+use clayloft_model::{DesignDoc, ModelSystems};
+
+/// What the user asked the files plugin to do.
+#[derive(Message, Debug, Clone, PartialEq)]
+pub enum FileCommand {
+    Open(PathBuf),
+    /// Save to this path, or to the document's own path.
+    Save(Option<PathBuf>),
+    ExportGcode(PathBuf),
+    ExportStl(PathBuf),
+}
+
+/// The last file operation's outcome, shown in the app (errors in red).
+#[derive(Resource, Debug, Clone, Default, PartialEq)]
+pub struct FileStatus {
+    pub message: Option<String>,
+    pub is_error: bool,
+}
+
+impl FileStatus {
+    fn ok(&mut self, m: String) {
+        self.message = Some(m);
+        self.is_error = false;
+    }
+    fn err(&mut self, m: String) {
+        self.message = Some(m);
+        self.is_error = true;
+    }
+}
+
+/// Where and how often the design is autosaved.
+#[derive(Resource, Debug, Clone)]
+pub struct Autosave {
+    pub dir: PathBuf,
+    /// Quiet time after the last change before writing (keeps drags from writing every frame).
+    pub delay: Duration,
+    /// Design last written (or restored), to skip unchanged writes.
+    written: Option<Design>,
+    pending_since: Option<Duration>,
+}
+
+impl Autosave {
+    pub fn new(dir: PathBuf) -> Autosave {
+        Autosave {
+            dir,
+            delay: Duration::from_millis(500),
+            written: None,
+            pending_since: None,
+        }
+    }
+
+    /// The default directory (see the module documentation).
+    pub fn default_dir() -> PathBuf {
+        if let Some(d) = std::env::var_os("CLAYLOFT_AUTOSAVE_DIR") {
+            return PathBuf::from(d);
+        }
+        if let Some(d) = std::env::var_os("XDG_STATE_HOME") {
+            return PathBuf::from(d).join("clayloft");
+        }
+        std::env::var_os("HOME")
+            .map(|h| PathBuf::from(h).join(".local/state/clayloft"))
+            .unwrap_or_else(|| std::env::temp_dir().join("clayloft"))
+    }
+
+    /// Autosave file of a document.
+    pub fn path_for(&self, doc_path: Option<&Path>) -> PathBuf {
+        let stem = doc_path
+            .and_then(|p| p.file_stem())
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "untitled".into());
+        self.dir.join(format!("{stem}.autosave.toml"))
+    }
+}
+
+pub struct FilesPlugin;
+
+impl Plugin for FilesPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.world().contains_resource::<Autosave>() {
+            app.insert_resource(Autosave::new(Autosave::default_dir()));
+        }
+        app.init_resource::<FileStatus>()
+            .add_message::<FileCommand>()
+            .add_systems(
+                Update,
+                (restore_autosave, run_file_commands)
+                    .chain()
+                    .in_set(ModelSystems::Edit),
+            )
+            .add_systems(Update, write_autosave.after(ModelSystems::Recompute));
+    }
+}
+
+/// Opens and checks a design file: the loader's one-line message on failure.
+pub fn open_design(path: &Path) -> Result<Design, String> {
+    clayloft_core::load_design(path)
+        .map(|l| l.design)
+        .map_err(|e| e.to_string())
+}
+
+/// Saves a design as TOML, atomically, and checks that it loads back identical.
+pub fn save_design(design: &Design, path: &Path) -> Result<(), String> {
+    let text = design.to_toml();
+    write_atomically(path, |w| w.write_all(text.as_bytes())).map_err(|e| e.to_string())?;
+    match open_design(path) {
+        Ok(back) if back == *design => Ok(()),
+        Ok(_) => Err(format!(
+            "{}: saved file does not load back identical",
+            path.display()
+        )),
+        Err(e) => Err(e),
+    }
+}
+
+/// Writes the G-code of a design, as `clayloft gcode` does.
+pub fn export_gcode(design: &Design, path: &Path) -> Result<String, String> {
+    let job = clayloft_core::run(design).map_err(|e| format!("{}: {e}", path.display()))?;
+    write_atomically(path, |w| clayloft_core::gcode::write_gcode(design, &job, w))
+        .map_err(|e| e.to_string())?;
+    let s = clayloft_core::gcode::summarize(design, &job);
+    Ok(format!(
+        "wrote {} ({} points, {:.1} m of path)",
+        path.display(),
+        job.toolpath.points.len(),
+        s.path_length_mm / 1000.0
+    ))
+}
+
+/// Writes the wall as a binary STL, as `clayloft stl` does.
+pub fn export_stl(design: &Design, path: &Path) -> Result<String, String> {
+    let surface = clayloft_core::pipeline::build_surface(design)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let mesh = clayloft_core::stl::wall_mesh(
+        &surface,
+        design.printer.line_width,
+        design.shape.base_layers,
+    );
+    write_atomically(path, |w| {
+        clayloft_core::stl::write_binary_stl(&mesh, &design.name, w)
+    })
+    .map_err(|e| e.to_string())?;
+    Ok(format!(
+        "wrote {} ({} triangles)",
+        path.display(),
+        mesh.triangles.len()
+    ))
+}
+
+fn run_file_commands(
+    mut commands: MessageReader<FileCommand>,
+    doc: Option<ResMut<DesignDoc>>,
+    mut status: ResMut<FileStatus>,
+    mut autosave: ResMut<Autosave>,
+) {
+    let Some(mut doc) = doc else { return };
+    for c in commands.read() {
+        match c {
+            FileCommand::Open(path) => match open_design(path) {
+                Ok(d) => {
+                    doc.design = d;
+                    doc.path = Some(path.clone());
+                    autosave.written = Some(doc.design.clone());
+                    status.ok(format!("opened {}", path.display()));
+                }
+                Err(e) => status.err(e),
+            },
+            FileCommand::Save(to) => {
+                let Some(path) = to.clone().or_else(|| doc.path.clone()) else {
+                    status.err("this design has no file yet: give a path to save to".into());
+                    continue;
+                };
+                match save_design(&doc.design, &path) {
+                    Ok(()) => {
+                        let _ = std::fs::remove_file(autosave.path_for(doc.path.as_deref()));
+                        autosave.written = Some(doc.design.clone());
+                        autosave.pending_since = None;
+                        doc.path = Some(path.clone());
+                        status.ok(format!("saved {}", path.display()));
+                    }
+                    Err(e) => status.err(e),
+                }
+            }
+            FileCommand::ExportGcode(path) => match export_gcode(&doc.design, path) {
+                Ok(m) => status.ok(m),
+                Err(e) => status.err(e),
+            },
+            FileCommand::ExportStl(path) => match export_stl(&doc.design, path) {
+                Ok(m) => status.ok(m),
+                Err(e) => status.err(e),
+            },
+        }
+    }
+}
+
+/// When a document appears (start-up), restores its autosave if that holds unsaved edits.
+fn restore_autosave(
+    doc: Option<ResMut<DesignDoc>>,
+    mut autosave: ResMut<Autosave>,
+    mut status: ResMut<FileStatus>,
+) {
+    let Some(mut doc) = doc else { return };
+    if !doc.is_added() {
+        return;
+    }
+    let path = autosave.path_for(doc.path.as_deref());
+    autosave.written = Some(doc.design.clone());
+    if !path.exists() {
+        return;
+    }
+    match open_design(&path) {
+        Ok(d) if d != doc.design => {
+            doc.design = d.clone();
+            autosave.written = Some(d);
+            status.ok(format!(
+                "restored unsaved edits from {} (save to keep them)",
+                path.display()
+            ));
+        }
+        Ok(_) => {}
+        Err(e) => status.err(format!("autosave not restored: {e}")),
+    }
+}
+
+/// Writes the autosave file a moment after the last change.
+fn write_autosave(
+    doc: Option<Res<DesignDoc>>,
+    time: Res<Time<Real>>,
+    mut autosave: ResMut<Autosave>,
+    mut status: ResMut<FileStatus>,
+) {
+    let Some(doc) = doc else { return };
+    let now = time.elapsed();
+    if autosave.written.as_ref() == Some(&doc.design) {
+        autosave.pending_since = None;
+        return;
+    }
+    let since = *autosave.pending_since.get_or_insert(now);
+    if now.saturating_sub(since) < autosave.delay {
+        return;
+    }
+    let path = autosave.path_for(doc.path.as_deref());
+    let text = doc.design.to_toml();
+    let result = std::fs::create_dir_all(&autosave.dir)
+        .map_err(|e| e.to_string())
+        .and_then(|_| {
+            write_atomically(&path, |w| w.write_all(text.as_bytes())).map_err(|e| e.to_string())
+        });
+    match result {
+        Ok(()) => {
+            autosave.written = Some(doc.design.clone());
+            autosave.pending_since = None;
+        }
+        Err(e) => {
+            status.err(format!("autosave failed: {e}"));
+            autosave.pending_since = Some(now); // try again after the delay
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn design_path() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/designs/pebble-spout.toml")
+    }
+
+    #[test]
+    fn every_shipped_design_saves_and_loads_back_identical() {
+        let dir = tempfile::tempdir().unwrap();
+        for entry in std::fs::read_dir(design_path().parent().unwrap()).unwrap() {
+            let p = entry.unwrap().path();
+            let d = open_design(&p).unwrap();
+            let out = dir.path().join(p.file_name().unwrap());
+            save_design(&d, &out).unwrap();
+            assert_eq!(open_design(&out).unwrap(), d, "{}", p.display());
+        }
+    }
+
+    #[test]
+    fn open_errors_name_the_file() {
+        let e = open_design(Path::new("/nonexistent/x.toml")).unwrap_err();
+        assert!(e.contains("/nonexistent/x.toml"), "{e}");
+    }
+
+    fn app(autosave_dir: &Path) -> App {
+        let mut app = App::new();
+        app.add_plugins(MinimalPlugins);
+        let mut a = Autosave::new(autosave_dir.to_path_buf());
+        a.delay = Duration::ZERO;
+        app.insert_resource(a);
+        app.add_plugins((clayloft_model::ModelPlugin, FilesPlugin));
+        app
+    }
+
+    #[test]
+    fn edits_are_autosaved_and_restored_after_a_kill() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = design_path();
+        let original = open_design(&path).unwrap();
+        {
+            let mut app = app(dir.path());
+            app.insert_resource(DesignDoc {
+                design: original.clone(),
+                path: Some(path.clone()),
+            });
+            app.update();
+            app.world_mut()
+                .resource_mut::<DesignDoc>()
+                .design
+                .shape
+                .height = 90.0;
+            app.update();
+            app.update();
+            // The app is dropped here without saving: as if killed.
+        }
+        let auto = dir.path().join("pebble-spout.autosave.toml");
+        assert_eq!(open_design(&auto).unwrap().shape.height, 90.0);
+        let mut app = app(dir.path());
+        app.insert_resource(DesignDoc {
+            design: original.clone(),
+            path: Some(path.clone()),
+        });
+        app.update();
+        assert_eq!(
+            app.world().resource::<DesignDoc>().design.shape.height,
+            90.0
+        );
+        let status = app.world().resource::<FileStatus>().clone();
+        assert!(status.message.unwrap().contains("restored unsaved edits"));
+        // Saving (elsewhere, not to touch the shipped design) removes the autosave.
+        let saved = dir.path().join("saved.toml");
+        app.world_mut()
+            .resource_mut::<Messages<FileCommand>>()
+            .write(FileCommand::Save(Some(saved.clone())));
+        app.update();
+        assert!(!auto.exists());
+        assert_eq!(open_design(&saved).unwrap().shape.height, 90.0);
+    }
+
+    #[test]
+    fn export_and_bad_paths_from_the_app() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut app = app(dir.path());
+        app.insert_resource(DesignDoc {
+            design: open_design(&design_path()).unwrap(),
+            path: None,
+        });
+        app.update();
+        let g = dir.path().join("v.gcode");
+        app.world_mut()
+            .resource_mut::<Messages<FileCommand>>()
+            .write(FileCommand::ExportGcode(g.clone()));
+        app.update();
+        let text = std::fs::read_to_string(&g).unwrap();
+        let report = clayloft_core::check::check_gcode(
+            &text,
+            &clayloft_core::check::Limits::from_header(&text).unwrap(),
+        )
+        .unwrap();
+        assert!(report.ok(), "{report}");
+        let bad = dir.path().join("missing-folder/v.stl");
+        app.world_mut()
+            .resource_mut::<Messages<FileCommand>>()
+            .write(FileCommand::ExportStl(bad.clone()));
+        app.update();
+        let status = app.world().resource::<FileStatus>().clone();
+        assert!(status.is_error && status.message.unwrap().contains("missing-folder"));
+        assert!(!bad.exists());
+        app.world_mut()
+            .resource_mut::<Messages<FileCommand>>()
+            .write(FileCommand::Open(dir.path().join("nope.toml")));
+        app.update();
+        assert!(app.world().resource::<FileStatus>().is_error);
+    }
+}

@@ -1,0 +1,85 @@
+//! Interactive speed (issue 3.6): one handle drag on a 360-sample × 200-layer design, through the
+//! ECS recompute (sections in the line's span, constraints, texture, toolpath) and the wall mesh
+//! rebuild. Must fit in one 60 fps frame (16.7 ms).
+
+use bevy::math::DVec3;
+use bevy::prelude::*;
+use clayloft_model::handles::{HandleRole, handle_frame, handle_position, set_handle};
+use clayloft_model::preview::wall_buffers;
+use clayloft_model::*;
+use criterion::{Criterion, criterion_group, criterion_main};
+
+const DESIGN: &str = r#"
+version = 1
+name = "bench 360 x 200"
+[printer]
+layer_height = 1.0
+[shape]
+height = 200.0
+samples = 360
+base_layers = 2
+lower = { type = "rose", radius = 40.0, amplitude = 4.0, petals = 6 }
+upper = { type = "circle", radius = 34.0 }
+[[control.vertical]]
+points = [[0.0, 0.0], [0.3, 0.0], [0.5, 8.0], [0.7, 0.0], [1.0, 0.0]]
+angle = 90.0
+width = 60.0
+[[control.vertical]]
+points = [[0.0, 0.0], [0.5, -5.0], [1.0, 0.0]]
+[texture]
+combine = "product"
+x = { wave = "sine", period = 20.0, amplitude = 1.0 }
+y = { wave = "sine", period = 10.0, amplitude = 1.0 }
+"#;
+
+fn drag_once(app: &mut App, sign: f64) {
+    let role = HandleRole::Line {
+        kind: LineKind::Vertical,
+        line: 0,
+        point: 2,
+    };
+    let world = app.world_mut();
+    let offsets = world
+        .query::<(&ContourRole, &ContourSamples)>()
+        .iter(world)
+        .map(|(r, s)| (*r, s.offset))
+        .collect();
+    let cache = world.resource::<ModelCache>().clone();
+    let mut doc = world.resource_mut::<DesignDoc>();
+    let frame = handle_frame(role, &doc.design, &cache, &offsets).unwrap();
+    let at = handle_position(role, &doc.design, &frame).unwrap();
+    set_handle(
+        role,
+        &mut doc.design,
+        &frame,
+        at + DVec3::new(0.0, sign, 0.0),
+    );
+}
+
+fn bench(c: &mut Criterion) {
+    let design = clayloft_core::load::parse_design(DESIGN).unwrap();
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, ModelPlugin));
+    app.insert_resource(DesignDoc { design, path: None });
+    app.update();
+    let mut sign = 1.0;
+    c.bench_function("drag_local_line_360x200_recompute_and_mesh", |b| {
+        b.iter(|| {
+            sign = -sign;
+            drag_once(&mut app, sign);
+            app.update();
+            let world = app.world_mut();
+            let surface = world
+                .query::<&VesselSurface>()
+                .single(world)
+                .unwrap()
+                .0
+                .clone();
+            let mesh = wall_buffers(&surface, 45.0).into_mesh();
+            std::hint::black_box(mesh);
+        })
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

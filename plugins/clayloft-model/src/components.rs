@@ -1,0 +1,83 @@
+//! The components of the model's entities. They hold data; the systems derive it.
+
+use std::sync::Arc;
+
+use bevy::math::{DVec2, DVec3};
+use bevy::prelude::*;
+use clayloft_core::pipeline::Surface;
+use clayloft_core::section::Section;
+use clayloft_core::toolpath::Toolpath;
+
+/// Which of the two contours an entity is.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ContourRole {
+    /// At z = 0, on the bed.
+    Lower,
+    /// At z = height, the rim.
+    Upper,
+}
+
+impl ContourRole {
+    pub const BOTH: [ContourRole; 2] = [ContourRole::Lower, ContourRole::Upper];
+    /// Field path of the contour in the design file.
+    pub fn field(self) -> &'static str {
+        match self {
+            ContourRole::Lower => "shape.lower",
+            ContourRole::Upper => "shape.upper",
+        }
+    }
+}
+
+/// A contour's samples by arc length and the translation alignment gave it.
+#[derive(Component, Debug, Clone, Default)]
+pub struct ContourSamples {
+    pub samples: Vec<DVec2>,
+    /// Spec coordinates + offset = bed coordinates.
+    pub offset: DVec2,
+}
+
+/// Section k of the surface (k = 0 on the bed .. = layers at the rim).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SectionIndex(pub usize);
+
+/// The shaped section (loft + control lines, before constraints and texture).
+#[derive(Component, Debug, Clone, Default)]
+pub struct ShapedSection(pub Section);
+
+/// Marker of the vessel entity.
+#[derive(Component, Debug, Clone, Copy, Default)]
+pub struct Vessel;
+
+/// The corrected, textured surface: what is printed.
+#[derive(Component, Debug, Clone)]
+pub struct VesselSurface(pub Arc<Surface>);
+
+/// The single spiral toolpath.
+#[derive(Component, Debug, Clone)]
+pub struct ToolpathPath(pub Arc<Toolpath>);
+
+/// Which kind of control line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LineKind {
+    Vertical,
+    Horizontal,
+}
+
+/// A control line of the design (`control.vertical[index]` or `control.horizontal[index]`).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ControlLine {
+    pub kind: LineKind,
+    pub index: usize,
+}
+
+/// The control line drawn on the surface, design space.
+#[derive(Component, Debug, Clone, Default)]
+pub struct ControlLineCurve(pub Vec<DVec3>);
+
+/// An editable point; its role says which design value it stands for.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct EditHandle(pub crate::handles::HandleRole);
+
+/// Where a handle sits, design space (mm); derived from the design.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct HandlePosition(pub DVec3);

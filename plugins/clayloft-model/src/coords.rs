@@ -1,0 +1,34 @@
+//! Design space (millimetres, z up, the printer's axes) and Bevy's world space (y up).
+//!
+//! `world = (x, z, −y)`: a right-handed rotation, so the vessel stands on the bed the way it prints.
+
+use bevy::math::{DVec3, Vec3};
+
+/// Design-space point (mm, z up) to a Bevy world position.
+#[inline]
+pub fn to_world(p: DVec3) -> Vec3 {
+    Vec3::new(p.x as f32, p.z as f32, -p.y as f32)
+}
+
+/// Bevy world position to a design-space point (mm, z up).
+#[inline]
+pub fn from_world(w: Vec3) -> DVec3 {
+    DVec3::new(w.x as f64, -w.z as f64, w.y as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_up_axis() {
+        let p = DVec3::new(10.0, 20.0, 30.0);
+        assert_eq!(from_world(to_world(p)), p);
+        assert_eq!(to_world(DVec3::Z), Vec3::Y);
+        // x × y = z in design space must stay right-handed in the world: x × (−z) = y.
+        assert_eq!(
+            to_world(DVec3::X).cross(to_world(DVec3::Y)),
+            to_world(DVec3::Z)
+        );
+    }
+}

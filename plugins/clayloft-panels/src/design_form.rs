@@ -1,0 +1,649 @@
+//! Every field of the design file (SPEC §6) as a form, grouped like the file.
+
+use bevy_egui::egui;
+use clayloft_core::Design;
+use clayloft_core::design::{
+    Combine, ContourSpec, ExtrusionMode, HorizontalLine, Texture, VerticalLine, Wave, WaveKind,
+};
+use clayloft_model::handles::HandleRole;
+
+use crate::widgets::{count, explain, number, point_list};
+
+pub fn design_form(ui: &mut egui::Ui, d: &mut Design, selected: Option<HandleRole>) {
+    ui.horizontal(|ui| {
+        ui.label("Name");
+        ui.text_edit_singleline(&mut d.name);
+    });
+    if let Some(role) = selected {
+        explain(
+            ui,
+            &format!(
+                "selected handle: {role:?} — drag it, or use the gizmo arrows for one axis at a time"
+            ),
+        );
+    }
+    egui::CollapsingHeader::new("Shape")
+        .default_open(true)
+        .show(ui, |ui| shape(ui, d));
+    egui::CollapsingHeader::new("Lower contour (on the bed)")
+        .default_open(true)
+        .show(ui, |ui| {
+            explain(ui, "The closed curve the vessel stands on.");
+            contour(ui, "lower", &mut d.shape.lower);
+        });
+    egui::CollapsingHeader::new("Upper contour (the rim)")
+        .default_open(true)
+        .show(ui, |ui| {
+            explain(
+                ui,
+                "The closed curve at the top; the wall is lofted between the two.",
+            );
+            contour(ui, "upper", &mut d.shape.upper);
+        });
+    egui::CollapsingHeader::new("Control lines")
+        .default_open(false)
+        .show(ui, |ui| control(ui, d));
+    egui::CollapsingHeader::new("Texture")
+        .default_open(false)
+        .show(ui, |ui| texture(ui, &mut d.texture));
+    egui::CollapsingHeader::new("Printer")
+        .default_open(false)
+        .show(ui, |ui| printer(ui, d));
+    egui::CollapsingHeader::new("Constraints").default_open(true).show(ui, |ui| {
+        ui.checkbox(&mut d.constraints.enforce, "enforce limits")
+            .on_hover_text("On: the shape is corrected locally so it prints. Off: violations are only reported.");
+        explain(
+            ui,
+            "Clay has no supports: every point may lean at most the overhang angle from the layer below, the nozzle holder must clear the printed part, and the path must be one continuous spiral.",
+        );
+    });
+}
+
+fn shape(ui: &mut egui::Ui, d: &mut Design) {
+    let s = &mut d.shape;
+    number(
+        ui,
+        "Height",
+        &mut s.height,
+        "mm",
+        1.0..=2000.0,
+        "Height of the vessel from the bed to the rim.",
+    );
+    count(
+        ui,
+        "Samples",
+        &mut s.samples,
+        3..=20_000,
+        "Points per section around the vessel: more follow curves more finely.",
+    );
+    count(
+        ui,
+        "Base layers",
+        &mut s.base_layers,
+        0..=20,
+        "Solid spiral layers that close the bottom (0 = open cylinder).",
+    );
+    let mut custom = s.center.is_some();
+    if ui
+        .checkbox(&mut custom, "Place off-centre")
+        .on_hover_text("By default the vessel stands at the bed centre.")
+        .changed()
+    {
+        s.center = custom.then(|| [d.printer.bed_x / 2.0, d.printer.bed_y / 2.0]);
+    }
+    if let Some(c) = &mut s.center {
+        number(
+            ui,
+            "Centre x",
+            &mut c[0],
+            "mm",
+            0.0..=10_000.0,
+            "Where the vessel's centre sits on the bed.",
+        );
+        number(
+            ui,
+            "Centre y",
+            &mut c[1],
+            "mm",
+            0.0..=10_000.0,
+            "Where the vessel's centre sits on the bed.",
+        );
+    }
+}
+
+fn contour_kind(spec: &ContourSpec) -> &'static str {
+    match spec {
+        ContourSpec::Circle { .. } => "circle",
+        ContourSpec::Ellipse { .. } => "ellipse",
+        ContourSpec::Polygon { .. } => "polygon",
+        ContourSpec::Star { .. } => "star",
+        ContourSpec::Rose { .. } => "rose",
+        ContourSpec::Spline { .. } => "spline",
+        ContourSpec::Image { .. } => "image",
+        ContourSpec::Svg { .. } => "svg",
+    }
+}
+
+fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
+    let kind = contour_kind(spec);
+    egui::ComboBox::from_id_salt(format!("{id} kind"))
+        .selected_text(kind)
+        .show_ui(ui, |ui| {
+            let r = 40.0;
+            let choices = [
+                ("circle", ContourSpec::Circle { radius: r }),
+                (
+                    "ellipse",
+                    ContourSpec::Ellipse {
+                        rx: r,
+                        ry: r * 0.75,
+                    },
+                ),
+                (
+                    "polygon",
+                    ContourSpec::Polygon {
+                        sides: 6,
+                        radius: r,
+                        corner_radius: 5.0,
+                    },
+                ),
+                (
+                    "star",
+                    ContourSpec::Star {
+                        points: 5,
+                        outer_radius: r,
+                        inner_radius: r * 0.75,
+                    },
+                ),
+                (
+                    "rose",
+                    ContourSpec::Rose {
+                        radius: r,
+                        amplitude: 4.0,
+                        petals: 6,
+                    },
+                ),
+                (
+                    "spline",
+                    ContourSpec::Spline {
+                        points: vec![[r, 0.0], [0.0, r], [-r, 0.0], [0.0, -r]],
+                    },
+                ),
+            ];
+            for (name, value) in choices {
+                if ui.selectable_label(kind == name, name).clicked() && kind != name {
+                    *spec = value;
+                }
+            }
+        });
+    match spec {
+        ContourSpec::Circle { radius } => number(
+            ui,
+            "Radius",
+            radius,
+            "mm",
+            1.0..=1000.0,
+            "Distance from the centre to the curve.",
+        ),
+        ContourSpec::Ellipse { rx, ry } => {
+            number(ui, "Radius x", rx, "mm", 1.0..=1000.0, "Semi-axis along x.");
+            number(ui, "Radius y", ry, "mm", 1.0..=1000.0, "Semi-axis along y.");
+        }
+        ContourSpec::Polygon {
+            sides,
+            radius,
+            corner_radius,
+        } => {
+            count(ui, "Sides", sides, 3..=64, "Number of straight sides.");
+            number(
+                ui,
+                "Radius",
+                radius,
+                "mm",
+                1.0..=1000.0,
+                "Centre to corner.",
+            );
+            number(
+                ui,
+                "Corner radius",
+                corner_radius,
+                "mm",
+                0.0..=500.0,
+                "Rounds the corners; sharp corners make the nozzle jerk.",
+            );
+        }
+        ContourSpec::Star {
+            points,
+            outer_radius,
+            inner_radius,
+        } => {
+            count(ui, "Points", points, 2..=64, "Number of tips.");
+            number(
+                ui,
+                "Outer radius",
+                outer_radius,
+                "mm",
+                1.0..=1000.0,
+                "Centre to a tip.",
+            );
+            number(
+                ui,
+                "Inner radius",
+                inner_radius,
+                "mm",
+                1.0..=1000.0,
+                "Centre to a notch.",
+            );
+        }
+        ContourSpec::Rose {
+            radius,
+            amplitude,
+            petals,
+        } => {
+            number(
+                ui,
+                "Radius",
+                radius,
+                "mm",
+                1.0..=1000.0,
+                "Mean radius r₀ of r(θ) = r₀ + a·cos(kθ).",
+            );
+            number(
+                ui,
+                "Amplitude",
+                amplitude,
+                "mm",
+                0.0..=500.0,
+                "How far the petals reach out and in.",
+            );
+            count(ui, "Petals", petals, 1..=64, "Number of petals k.");
+        }
+        ContourSpec::Spline { points } => {
+            explain(
+                ui,
+                "A smooth closed curve through these points (centripetal Catmull–Rom), in mm around the centre.",
+            );
+            point_list(
+                ui,
+                &format!("{id} spline"),
+                points,
+                ["x", "y"],
+                [" mm", " mm"],
+                3,
+            );
+        }
+        ContourSpec::Image { path, size } | ContourSpec::Svg { path, size } => {
+            ui.horizontal(|ui| {
+                ui.label("File");
+                ui.text_edit_singleline(path);
+            });
+            number(
+                ui,
+                "Size",
+                size,
+                "mm",
+                1.0..=1000.0,
+                "Length of the longer side.",
+            );
+        }
+    }
+}
+
+fn control(ui: &mut egui::Ui, d: &mut Design) {
+    explain(
+        ui,
+        "Vertical lines push the wall out (or in) along its height; horizontal lines raise or lower a section around the vessel.",
+    );
+    let mut remove = None;
+    for (l, v) in d.control.vertical.iter_mut().enumerate() {
+        ui.group(|ui| {
+            ui.horizontal(|ui| {
+                ui.strong(format!("Vertical line {l}"));
+                if ui.small_button("remove").clicked() {
+                    remove = Some(l);
+                }
+            });
+            let mut local = v.angle.is_some();
+            if ui
+                .checkbox(&mut local, "local")
+                .on_hover_text("Act only around one angle, with a smooth fall-off.")
+                .changed()
+            {
+                v.angle = local.then_some(0.0);
+                v.width = local.then_some(60.0);
+            }
+            if let Some(a) = &mut v.angle {
+                number(
+                    ui,
+                    "Angle",
+                    a,
+                    "°",
+                    -360.0..=360.0,
+                    "Where around the vessel it acts, counter-clockwise from +x.",
+                );
+            }
+            if let Some(w) = &mut v.width {
+                number(
+                    ui,
+                    "Width",
+                    w,
+                    "°",
+                    1.0..=360.0,
+                    "How wide around the vessel it acts.",
+                );
+            }
+            explain(
+                ui,
+                "Points: height fraction t (0 = bed, 1 = rim) and outward offset in mm.",
+            );
+            point_list(
+                ui,
+                &format!("v{l}"),
+                &mut v.points,
+                ["t", "offset"],
+                ["", " mm"],
+                2,
+            );
+        });
+    }
+    if let Some(l) = remove {
+        d.control.vertical.remove(l);
+    }
+    if ui.button("+ vertical line").clicked() {
+        d.control.vertical.push(VerticalLine {
+            points: vec![[0.0, 0.0], [0.5, 5.0], [1.0, 0.0]],
+            angle: None,
+            width: None,
+        });
+    }
+    let mut remove = None;
+    for (l, h) in d.control.horizontal.iter_mut().enumerate() {
+        ui.group(|ui| {
+            ui.horizontal(|ui| {
+                ui.strong(format!("Horizontal line {l}"));
+                if ui.small_button("remove").clicked() {
+                    remove = Some(l);
+                }
+            });
+            number(
+                ui,
+                "At",
+                &mut h.at,
+                "",
+                0.0..=1.0,
+                "Height fraction where the line acts fully.",
+            );
+            number(
+                ui,
+                "Reach",
+                &mut h.reach,
+                "",
+                0.001..=1.0,
+                "Height fraction over which the effect fades out.",
+            );
+            explain(
+                ui,
+                "Points: angle in degrees and the z offset in mm (a wavy rim).",
+            );
+            point_list(
+                ui,
+                &format!("h{l}"),
+                &mut h.points,
+                ["angle", "dz"],
+                ["°", " mm"],
+                2,
+            );
+        });
+    }
+    if let Some(l) = remove {
+        d.control.horizontal.remove(l);
+    }
+    if ui.button("+ horizontal line").clicked() {
+        d.control.horizontal.push(HorizontalLine {
+            at: 1.0,
+            reach: 0.3,
+            points: vec![[0.0, 0.0], [90.0, 5.0], [180.0, 0.0], [270.0, 5.0]],
+        });
+    }
+}
+
+fn wave(ui: &mut egui::Ui, id: &str, w: &mut Option<Wave>, period_unit: &str) {
+    let mut on = w.is_some();
+    if ui.checkbox(&mut on, format!("{id} wave")).changed() {
+        *w = on.then_some(Wave {
+            wave: WaveKind::Sine,
+            period: 10.0,
+            amplitude: 1.0,
+        });
+    }
+    if let Some(w) = w {
+        egui::ComboBox::from_id_salt(format!("{id} wave kind"))
+            .selected_text(format!("{:?}", w.wave).to_lowercase())
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut w.wave, WaveKind::Sine, "sine");
+                ui.selectable_value(&mut w.wave, WaveKind::Triangle, "triangle");
+                ui.selectable_value(&mut w.wave, WaveKind::Square, "square");
+            });
+        number(
+            ui,
+            "Period",
+            &mut w.period,
+            period_unit,
+            0.1..=10_000.0,
+            "Length of one wave.",
+        );
+        number(
+            ui,
+            "Amplitude",
+            &mut w.amplitude,
+            "mm",
+            0.0..=50.0,
+            "How far the surface moves along its normal.",
+        );
+    }
+}
+
+fn texture(ui: &mut egui::Ui, t: &mut Option<Texture>) {
+    explain(
+        ui,
+        "Periodic waves pressed into the wall along its normal: x runs around the vessel, y up it.",
+    );
+    let mut on = t.is_some();
+    if ui.checkbox(&mut on, "textured").changed() {
+        *t = on.then(|| Texture {
+            combine: Combine::Product,
+            x: Some(Wave {
+                wave: WaveKind::Sine,
+                period: 20.0,
+                amplitude: 1.0,
+            }),
+            y: None,
+            phase_drift: 0.0,
+            start: 0.0,
+            end: 1.0,
+        });
+    }
+    let Some(t) = t else { return };
+    egui::ComboBox::from_id_salt("combine")
+        .selected_text(format!("{:?}", t.combine).to_lowercase())
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut t.combine, Combine::Product, "product");
+            ui.selectable_value(&mut t.combine, Combine::Sum, "sum");
+        });
+    wave(ui, "x", &mut t.x, "samples");
+    wave(ui, "y", &mut t.y, "layers");
+    number(
+        ui,
+        "Phase drift",
+        &mut t.phase_drift,
+        "samples/layer",
+        -1000.0..=1000.0,
+        "Shift of the x wave per layer: twists the texture.",
+    );
+    number(
+        ui,
+        "Start",
+        &mut t.start,
+        "",
+        0.0..=1.0,
+        "Height fraction where the texture begins.",
+    );
+    number(
+        ui,
+        "End",
+        &mut t.end,
+        "",
+        0.0..=1.0,
+        "Height fraction where it ends.",
+    );
+}
+
+fn printer(ui: &mut egui::Ui, d: &mut Design) {
+    let p = &mut d.printer;
+    explain(
+        ui,
+        "Defaults are the paper's clay printer. Layer limits keep the bead stacked; speeds set the print time.",
+    );
+    number(
+        ui,
+        "Bed x",
+        &mut p.bed_x,
+        "mm",
+        10.0..=10_000.0,
+        "Bed size along x.",
+    );
+    number(
+        ui,
+        "Bed y",
+        &mut p.bed_y,
+        "mm",
+        10.0..=10_000.0,
+        "Bed size along y.",
+    );
+    number(
+        ui,
+        "Build height",
+        &mut p.max_z,
+        "mm",
+        10.0..=10_000.0,
+        "Highest the nozzle can go.",
+    );
+    number(
+        ui,
+        "Nozzle diameter",
+        &mut p.nozzle_diameter,
+        "mm",
+        0.1..=20.0,
+        "Opening of the nozzle.",
+    );
+    number(
+        ui,
+        "Line width",
+        &mut p.line_width,
+        "mm",
+        0.1..=50.0,
+        "Width of the clay bead: the wall is this thick.",
+    );
+    number(
+        ui,
+        "Layer height",
+        &mut p.layer_height,
+        "mm",
+        0.05..=20.0,
+        "Nominal height of each layer.",
+    );
+    number(
+        ui,
+        "Min layer height",
+        &mut p.min_layer_height,
+        "mm",
+        0.01..=20.0,
+        "Thinner layers smear the bead.",
+    );
+    number(
+        ui,
+        "Max layer height",
+        &mut p.max_layer_height,
+        "mm",
+        0.01..=20.0,
+        "Thicker layers do not bond.",
+    );
+    number(
+        ui,
+        "Nozzle length",
+        &mut p.nozzle_length,
+        "mm",
+        1.0..=500.0,
+        "Tube length below the holder: printed clay may rise at most this far above the tip.",
+    );
+    number(
+        ui,
+        "Max overhang",
+        &mut p.max_overhang_deg,
+        "°",
+        1.0..=89.0,
+        "Largest lean from vertical that clay holds without support.",
+    );
+    number(
+        ui,
+        "Print speed",
+        &mut p.print_speed,
+        "mm/s",
+        0.1..=500.0,
+        "Speed along the wall.",
+    );
+    number(
+        ui,
+        "Travel speed",
+        &mut p.travel_speed,
+        "mm/s",
+        0.1..=500.0,
+        "Approach and exit moves only.",
+    );
+    number(
+        ui,
+        "Feed diameter",
+        &mut p.feed_diameter,
+        "mm",
+        0.1..=100.0,
+        "Calibration of E: the extruder's equivalent filament diameter.",
+    );
+    number(
+        ui,
+        "Flow multiplier",
+        &mut p.flow_multiplier,
+        "×",
+        0.01..=10.0,
+        "Scales all extrusion.",
+    );
+    number(
+        ui,
+        "Min layer time",
+        &mut p.min_layer_time,
+        "s",
+        0.0..=600.0,
+        "Small layers slow down so the clay stiffens (0 = off).",
+    );
+    number(
+        ui,
+        "Flow ramp start",
+        &mut p.flow_ramp_start,
+        "mm",
+        0.0..=1000.0,
+        "Path length over which flow rises at the start.",
+    );
+    number(
+        ui,
+        "Flow ramp end",
+        &mut p.flow_ramp_end,
+        "mm",
+        0.0..=1000.0,
+        "Path length over which flow falls at the end.",
+    );
+    ui.horizontal(|ui| {
+        ui.label("Extrusion")
+            .on_hover_text("E values per move (M83) or cumulative (M82).");
+        ui.selectable_value(&mut p.extrusion, ExtrusionMode::Relative, "relative");
+        ui.selectable_value(&mut p.extrusion, ExtrusionMode::Absolute, "absolute");
+    });
+}

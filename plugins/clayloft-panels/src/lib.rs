@@ -1,0 +1,307 @@
+//! The panels (SPEC §8): a file bar, the design's parameters on the left (every field of the
+//! design file, with units and a short explanation), findings and the nozzle replay on the right,
+//! and a status line. Panels edit the design document only; everything else follows from it.
+
+mod design_form;
+mod widgets;
+
+use std::path::PathBuf;
+
+use bevy::prelude::*;
+use bevy_egui::{EguiContexts, EguiPlugin, EguiPrimaryContextPass, egui};
+use clayloft_core::gcode::format_duration;
+use clayloft_edit::{HistoryCommand, PanelInUse, Selection};
+use clayloft_files::{FileCommand, FileStatus};
+use clayloft_model::*;
+use clayloft_replay::{Replay, ReplayPath};
+use clayloft_view::{ViewSettings, WallStats};
+
+/// Paths typed in the file bar.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct FileFields {
+    pub design: String,
+    pub gcode: String,
+    pub stl: String,
+    initialised: bool,
+}
+
+pub struct PanelsPlugin;
+
+impl Plugin for PanelsPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<EguiPlugin>() {
+            app.add_plugins(EguiPlugin::default());
+        }
+        app.init_resource::<FileFields>()
+            .add_systems(EguiPrimaryContextPass, draw_panels);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn draw_panels(
+    mut contexts: EguiContexts,
+    doc: Option<ResMut<DesignDoc>>,
+    status: Res<ModelStatus>,
+    file_status: Res<FileStatus>,
+    mut fields: ResMut<FileFields>,
+    mut files: MessageWriter<FileCommand>,
+    mut history_cmd: MessageWriter<HistoryCommand>,
+    history: Res<clayloft_edit::History>,
+    mut settings: ResMut<ViewSettings>,
+    mut replay: ResMut<Replay>,
+    replay_path: Res<ReplayPath>,
+    wall: Res<WallStats>,
+    vessel: Query<&VesselSurface>,
+    toolpath: Query<&ToolpathPath>,
+    selection: Res<Selection>,
+    mut panel: ResMut<PanelInUse>,
+) -> Result {
+    let ctx = contexts.ctx_mut()?.clone();
+    let Some(mut doc) = doc else { return Ok(()) };
+    if !fields.initialised {
+        fields.initialised = true;
+        let base = doc
+            .path
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("untitled.toml"));
+        fields.design = base.display().to_string();
+        fields.gcode = base.with_extension("gcode").display().to_string();
+        fields.stl = base.with_extension("stl").display().to_string();
+    }
+    let mut root = egui::Ui::new(
+        ctx.clone(),
+        "root".into(),
+        egui::UiBuilder::new()
+            .layer_id(egui::LayerId::background())
+            .max_rect(ctx.viewport_rect()),
+    );
+    let mut design = doc.design.clone();
+
+    egui::Panel::top("file bar").show(&mut root, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            ui.label("Design");
+            ui.add(egui::TextEdit::singleline(&mut fields.design).desired_width(260.0));
+            if ui
+                .button("Open")
+                .on_hover_text("Open this design file (TOML, SPEC §6)")
+                .clicked()
+            {
+                files.write(FileCommand::Open(PathBuf::from(&fields.design)));
+            }
+            if ui
+                .button("Save")
+                .on_hover_text("Save the design to this path; it loads back identical")
+                .clicked()
+            {
+                files.write(FileCommand::Save(Some(PathBuf::from(&fields.design))));
+            }
+            ui.separator();
+            ui.add(egui::TextEdit::singleline(&mut fields.gcode).desired_width(180.0));
+            if ui
+                .button("Export G-code")
+                .on_hover_text("The single spiral path, as `clayloft gcode` writes it")
+                .clicked()
+            {
+                files.write(FileCommand::ExportGcode(PathBuf::from(&fields.gcode)));
+            }
+            ui.add(egui::TextEdit::singleline(&mut fields.stl).desired_width(160.0));
+            if ui
+                .button("Export STL")
+                .on_hover_text("The printed wall as a closed mesh")
+                .clicked()
+            {
+                files.write(FileCommand::ExportStl(PathBuf::from(&fields.stl)));
+            }
+            ui.separator();
+            if ui
+                .add_enabled(history.can_undo(), egui::Button::new("↶ Undo"))
+                .on_hover_text("Ctrl+Z")
+                .clicked()
+            {
+                history_cmd.write(HistoryCommand::Undo);
+            }
+            if ui
+                .add_enabled(history.can_redo(), egui::Button::new("↷ Redo"))
+                .on_hover_text("Ctrl+Shift+Z")
+                .clicked()
+            {
+                history_cmd.write(HistoryCommand::Redo);
+            }
+            ui.separator();
+            ui.checkbox(&mut settings.show_wall, "wall");
+            ui.checkbox(&mut settings.show_toolpath, "toolpath");
+            ui.checkbox(&mut settings.show_control_lines, "control lines");
+            ui.checkbox(&mut settings.show_build_volume, "build volume");
+        });
+    });
+
+    egui::Panel::bottom("status line").show(&mut root, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            if let (Some(s), Some(tp)) = (vessel.iter().next(), toolpath.iter().next()) {
+                let job_time = tp.0.print_time();
+                ui.label(format!(
+                    "{} layers · {} points · path {:.1} m · print ≈ {} · max overhang {:.1}°",
+                    s.0.layers,
+                    tp.0.points.len(),
+                    tp.0.length() / 1000.0,
+                    format_duration(job_time),
+                    s.0.metrics.max_overhang_deg,
+                ));
+                if wall.violating_points > 0 {
+                    ui.colored_label(
+                        egui::Color32::from_rgb(240, 60, 60),
+                        format!(
+                            "{} points past the overhang limit (red)",
+                            wall.violating_points
+                        ),
+                    );
+                }
+            }
+            if let Some(e) = &status.error {
+                ui.colored_label(egui::Color32::from_rgb(255, 90, 90), format!("⚠ {e}"));
+            }
+            if let Some(m) = &file_status.message {
+                let c = if file_status.is_error {
+                    egui::Color32::from_rgb(255, 90, 90)
+                } else {
+                    egui::Color32::from_rgb(150, 220, 150)
+                };
+                ui.colored_label(c, m);
+            }
+        });
+    });
+
+    egui::Panel::left("design")
+        .resizable(true)
+        .default_size(330.0)
+        .show(&mut root, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                design_form::design_form(ui, &mut design, selection.0);
+            });
+        });
+
+    egui::Panel::right("checks")
+        .resizable(true)
+        .default_size(300.0)
+        .show(&mut root, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                replay_panel(ui, &mut replay, &replay_path);
+                ui.separator();
+                findings_panel(ui, vessel.iter().next(), &design);
+            });
+        });
+
+    if design != doc.design {
+        doc.design = design;
+    }
+    panel.hovered = ctx.egui_wants_pointer_input() || ctx.is_pointer_over_egui();
+    panel.editing = ctx.egui_is_using_pointer();
+    Ok(())
+}
+
+fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
+    ui.heading("Nozzle replay");
+    ui.label(
+        egui::RichText::new(
+            "Watch the nozzle lay the spiral. The holder above the tube must never touch what is already printed; the wall must never lean past the overhang limit.",
+        )
+        .small()
+        .weak(),
+    );
+    let total = path.timeline.total_s();
+    ui.horizontal(|ui| {
+        if ui.toggle_value(&mut replay.active, "show").changed() && !replay.active {
+            replay.playing = false;
+        }
+        let label = if replay.playing {
+            "⏸ pause"
+        } else {
+            "▶ play"
+        };
+        if ui.button(label).clicked() {
+            replay.active = true;
+            if !replay.playing && replay.time_s >= total {
+                replay.time_s = 0.0;
+            }
+            replay.playing = !replay.playing;
+        }
+        if ui.button("⏮").on_hover_text("back to the start").clicked() {
+            replay.time_s = 0.0;
+        }
+    });
+    let mut t = replay.time_s;
+    let label = format!("{} / {}", format_duration(t), format_duration(total));
+    let scrub = ui.add(
+        egui::Slider::new(&mut t, 0.0..=total.max(1e-3))
+            .show_value(false)
+            .text(label),
+    );
+    if scrub.changed() {
+        replay.active = true;
+        replay.time_s = t;
+    }
+    ui.add(
+        egui::Slider::new(&mut replay.speed, 1.0..=2000.0)
+            .logarithmic(true)
+            .suffix("×")
+            .text("speed"),
+    );
+    let passed = path.passed_events();
+    if let Some(e) = path.flag_now() {
+        ui.colored_label(
+            egui::Color32::from_rgb(255, 80, 80),
+            format!("⚠ {} at point {} ({:.1})", e.what, e.line, e.value),
+        );
+    }
+    if path.events.is_empty() {
+        ui.colored_label(
+            egui::Color32::from_rgb(150, 220, 150),
+            "no collision, overhang or unsupported point on this path",
+        );
+    } else {
+        ui.label(format!(
+            "{} of {} flagged points passed",
+            passed.len(),
+            path.events.len()
+        ));
+        egui::ScrollArea::vertical()
+            .id_salt("events")
+            .max_height(140.0)
+            .show(ui, |ui| {
+                for e in passed.iter().rev().take(200) {
+                    ui.label(format!("point {}: {} ({:.1})", e.line, e.what, e.value));
+                }
+            });
+    }
+}
+
+fn findings_panel(
+    ui: &mut egui::Ui,
+    surface: Option<&VesselSurface>,
+    design: &clayloft_core::Design,
+) {
+    ui.heading("Constraints");
+    ui.label(
+        egui::RichText::new(format!(
+            "Clay cannot bridge or be supported: every layer must rest on the one below, leaning at most {}° (wall colour: clay = upright, amber = near the limit, red = past it).",
+            design.printer.max_overhang_deg
+        ))
+        .small()
+        .weak(),
+    );
+    let Some(s) = surface else { return };
+    if s.0.findings.is_empty() {
+        ui.colored_label(
+            egui::Color32::from_rgb(150, 220, 150),
+            "the design keeps every limit as drawn",
+        );
+    }
+    for f in &s.0.findings {
+        let color = if f.corrected {
+            egui::Color32::from_rgb(240, 200, 90)
+        } else {
+            egui::Color32::from_rgb(255, 90, 90)
+        };
+        ui.colored_label(color, f.to_string());
+    }
+}

@@ -1,0 +1,392 @@
+//! The nozzle replay (SPEC §8 "Simulation"): an animated nozzle — tip, tube of `nozzle_length`
+//! and the holder above it — follows the spiral at the printer's speeds (times a replay speed);
+//! play, pause, scrub. The printed part grows behind it, layer by layer. Every point where the
+//! holder would hit the part, or the path overhangs or has nothing under it, is found by the same
+//! checker as `clayloft check` ([`clayloft_core::check::check_path`]); passing one is flagged on
+//! screen and listed.
+
+pub mod timeline;
+
+use bevy::picking::Pickable;
+use bevy::prelude::*;
+use clayloft_core::check::{Limits, PathEvent, check_path};
+use clayloft_model::coords::to_world;
+use clayloft_model::preview::{WallBuffers, wall_buffers};
+use clayloft_model::*;
+use clayloft_view::ViewSettings;
+
+pub use timeline::Timeline;
+
+/// Replay state: the panels drive it, the systems follow it.
+#[derive(Resource, Debug, Clone)]
+pub struct Replay {
+    /// The replay is shown (nozzle, growing part) instead of the finished wall.
+    pub active: bool,
+    pub playing: bool,
+    /// Replay speed, times real print time.
+    pub speed: f64,
+    /// Position in print time, s.
+    pub time_s: f64,
+}
+
+impl Default for Replay {
+    fn default() -> Self {
+        Replay {
+            active: false,
+            playing: false,
+            speed: 30.0,
+            time_s: 0.0,
+        }
+    }
+}
+
+/// What the replay knows about the current toolpath: its timeline and the checker's events.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct ReplayPath {
+    pub timeline: Timeline,
+    pub events: Vec<PathEvent>,
+    /// Index of the path point the nozzle is at (or just past).
+    pub index: usize,
+    /// Events passed so far (an index into `events`).
+    pub passed: usize,
+}
+
+impl ReplayPath {
+    /// The events the nozzle has passed, most recent last.
+    pub fn passed_events(&self) -> &[PathEvent] {
+        &self.events[..self.passed]
+    }
+
+    /// Whether the point the nozzle is at is flagged (a collision or overhang happening now).
+    pub fn flag_now(&self) -> Option<&PathEvent> {
+        self.passed
+            .checked_sub(1)
+            .map(|i| &self.events[i])
+            .filter(|e| self.index.saturating_sub(e.line) < 40)
+    }
+}
+
+/// Marker of the nozzle's root entity (at the tip).
+#[derive(Component, Debug, Clone, Copy)]
+pub struct Nozzle;
+
+/// Marker of the holder part of the nozzle (turns red on a collision).
+#[derive(Component, Debug, Clone, Copy)]
+pub struct NozzleHolder;
+
+/// Marker of the printed-part mesh.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct PrintedPart;
+
+/// The full wall buffers the printed part is cut from, and the rows shown.
+#[derive(Resource, Debug, Clone, Default)]
+struct PrintedSource {
+    buffers: WallBuffers,
+    samples: usize,
+    rows_shown: usize,
+}
+
+#[derive(Resource)]
+struct NozzleLook {
+    holder_ok: Handle<StandardMaterial>,
+    holder_hit: Handle<StandardMaterial>,
+}
+
+pub struct ReplayPlugin;
+
+impl Plugin for ReplayPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<Replay>()
+            .init_resource::<ReplayPath>()
+            .init_resource::<PrintedSource>()
+            .add_systems(Startup, spawn_nozzle)
+            .add_systems(
+                Update,
+                (
+                    prepare_replay_path,
+                    advance_replay,
+                    follow_path,
+                    grow_printed_part,
+                    swap_wall_for_printed_part,
+                    draw_flags,
+                )
+                    .chain()
+                    .in_set(ModelSystems::View),
+            );
+    }
+}
+
+fn spawn_nozzle(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let steel = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.75, 0.77, 0.8),
+        metallic: 0.7,
+        perceptual_roughness: 0.35,
+        ..default()
+    });
+    let holder_ok = materials.add(StandardMaterial {
+        base_color: Color::srgba(0.35, 0.5, 0.75, 0.8),
+        alpha_mode: AlphaMode::Blend,
+        ..default()
+    });
+    let holder_hit = materials.add(StandardMaterial {
+        base_color: Color::srgba(0.95, 0.1, 0.1, 0.85),
+        emissive: LinearRgba::rgb(2.0, 0.0, 0.0),
+        alpha_mode: AlphaMode::Blend,
+        ..default()
+    });
+    commands.insert_resource(NozzleLook {
+        holder_ok: holder_ok.clone(),
+        holder_hit,
+    });
+    commands
+        .spawn((
+            Nozzle,
+            Transform::default(),
+            Visibility::Hidden,
+            Name::new("nozzle"),
+        ))
+        .with_children(|n| {
+            // Unit-height parts, scaled to the printer's nozzle in `follow_path`.
+            n.spawn((
+                Mesh3d(meshes.add(Cone::new(1.0, 1.0))),
+                MeshMaterial3d(steel.clone()),
+                Transform::default(),
+                NozzlePart::Tip,
+                Pickable::IGNORE,
+            ));
+            n.spawn((
+                Mesh3d(meshes.add(Cylinder::new(1.0, 1.0))),
+                MeshMaterial3d(steel),
+                Transform::default(),
+                NozzlePart::Tube,
+                Pickable::IGNORE,
+            ));
+            n.spawn((
+                Mesh3d(meshes.add(Cylinder::new(1.0, 1.0))),
+                MeshMaterial3d(holder_ok),
+                Transform::default(),
+                NozzlePart::Holder,
+                NozzleHolder,
+                Pickable::IGNORE,
+            ));
+        });
+    commands.spawn((
+        PrintedPart,
+        Mesh3d(meshes.add(Mesh::from(Cuboid::new(0.0, 0.0, 0.0)))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::WHITE,
+            perceptual_roughness: 0.85,
+            double_sided: true,
+            cull_mode: None,
+            ..default()
+        })),
+        Visibility::Hidden,
+        Pickable::IGNORE,
+        Name::new("printed part"),
+    ));
+}
+
+/// The parts of the nozzle model, sized from the printer.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+enum NozzlePart {
+    Tip,
+    Tube,
+    Holder,
+}
+
+/// Holder size drawn above the tube, mm (the collision test uses the plane at its bottom).
+const HOLDER_RADIUS: f32 = 14.0;
+const HOLDER_HEIGHT: f32 = 35.0;
+
+fn prepare_replay_path(
+    path: Query<&ToolpathPath, Changed<ToolpathPath>>,
+    vessel: Query<&VesselSurface>,
+    doc: Option<Res<DesignDoc>>,
+    mut replay_path: ResMut<ReplayPath>,
+    mut source: ResMut<PrintedSource>,
+    mut replay: ResMut<Replay>,
+) {
+    let (Some(path), Some(doc)) = (path.iter().next(), doc) else {
+        return;
+    };
+    let points: Vec<_> = path.0.points.iter().map(|p| p.pos).collect();
+    let report = check_path(&points, &Limits::from(&doc.design.printer));
+    replay_path.timeline = Timeline::new(&path.0);
+    replay_path.events = report.events;
+    replay_path.passed = 0;
+    replay.time_s = replay.time_s.min(replay_path.timeline.total_s());
+    if let Some(surface) = vessel.iter().next() {
+        *source = PrintedSource {
+            buffers: wall_buffers(&surface.0, doc.design.printer.max_overhang_deg),
+            samples: surface.0.sections.first().map_or(0, |s| s.points.len()),
+            rows_shown: usize::MAX,
+        };
+    }
+}
+
+fn advance_replay(time: Res<Time>, mut replay: ResMut<Replay>, mut path: ResMut<ReplayPath>) {
+    let total = path.timeline.total_s();
+    if replay.playing && replay.active {
+        replay.time_s += time.delta_secs_f64() * replay.speed;
+        if replay.time_s >= total {
+            replay.time_s = total;
+            replay.playing = false;
+        }
+    }
+    let index = path.timeline.index_at(replay.time_s);
+    path.index = index;
+    path.passed = path.events.partition_point(|e| e.line <= index);
+}
+
+fn follow_path(
+    replay: Res<Replay>,
+    path: Res<ReplayPath>,
+    toolpath: Query<&ToolpathPath>,
+    doc: Option<Res<DesignDoc>>,
+    look: Option<Res<NozzleLook>>,
+    mut nozzle: Single<(&mut Transform, &mut Visibility), With<Nozzle>>,
+    mut parts: Query<
+        (
+            &NozzlePart,
+            &mut Transform,
+            Option<&mut MeshMaterial3d<StandardMaterial>>,
+        ),
+        Without<Nozzle>,
+    >,
+) {
+    let (Some(tp), Some(doc), Some(look)) = (toolpath.iter().next(), doc, look) else {
+        return;
+    };
+    let (t, v) = &mut *nozzle;
+    *v.as_mut() = if replay.active {
+        Visibility::Inherited
+    } else {
+        Visibility::Hidden
+    };
+    if !replay.active {
+        return;
+    }
+    if let Some(p) = path.timeline.position_at(&tp.0, replay.time_s) {
+        t.translation = to_world(p);
+    }
+    let p = &doc.design.printer;
+    let r = (p.nozzle_diameter as f32 / 2.0).max(0.5);
+    let len = p.nozzle_length as f32;
+    let colliding = path
+        .flag_now()
+        .is_some_and(|e| e.what == clayloft_core::check::COLLISION);
+    for (part, mut tr, mat) in &mut parts {
+        match part {
+            NozzlePart::Tip => {
+                *tr = Transform::from_xyz(0.0, r * 1.5, 0.0)
+                    .with_rotation(Quat::from_rotation_x(std::f32::consts::PI))
+                    .with_scale(Vec3::new(r * 1.6, r * 3.0, r * 1.6));
+            }
+            NozzlePart::Tube => {
+                *tr = Transform::from_xyz(0.0, len / 2.0 + r * 1.5, 0.0).with_scale(Vec3::new(
+                    r * 1.6,
+                    len,
+                    r * 1.6,
+                ));
+            }
+            NozzlePart::Holder => {
+                *tr = Transform::from_xyz(0.0, len + HOLDER_HEIGHT / 2.0, 0.0)
+                    .with_scale(Vec3::new(HOLDER_RADIUS, HOLDER_HEIGHT, HOLDER_RADIUS));
+                if let Some(mut m) = mat {
+                    let want = if colliding {
+                        &look.holder_hit
+                    } else {
+                        &look.holder_ok
+                    };
+                    if m.0 != *want {
+                        m.0 = want.clone();
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The printed part: the wall up to the section the nozzle has reached.
+fn grow_printed_part(
+    replay: Res<Replay>,
+    path: Res<ReplayPath>,
+    toolpath: Query<&ToolpathPath>,
+    vessel: Query<&VesselSurface>,
+    mut source: ResMut<PrintedSource>,
+    part: Single<&Mesh3d, With<PrintedPart>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    if !replay.active || source.samples == 0 {
+        return;
+    }
+    let (Some(tp), Some(surface)) = (toolpath.iter().next(), vessel.iter().next()) else {
+        return;
+    };
+    let z = tp.0.points.get(path.index).map_or(0.0, |p| p.pos.z);
+    let rows_total = surface.0.sections.len();
+    // Rows whose sections lie wholly below the nozzle are printed.
+    let rows = surface
+        .0
+        .sections
+        .partition_point(|s| s.z_range().1 <= z + 1e-6)
+        .min(rows_total);
+    if rows == source.rows_shown {
+        return;
+    }
+    source.rows_shown = rows;
+    let quads = rows.saturating_sub(1) * source.samples * 6;
+    let mut b = source.buffers.clone();
+    b.indices.truncate(quads);
+    let _ = meshes.insert(part.0.id(), b.into_mesh());
+}
+
+fn swap_wall_for_printed_part(
+    replay: Res<Replay>,
+    mut settings: ResMut<ViewSettings>,
+    mut part: Single<&mut Visibility, With<PrintedPart>>,
+    mut was_active: Local<Option<bool>>,
+) {
+    if *was_active == Some(replay.active) {
+        return;
+    }
+    // Entering the replay hides the finished wall; leaving it shows it again.
+    if was_active.is_some() || replay.active {
+        settings.show_wall = !replay.active;
+    }
+    *was_active = Some(replay.active);
+    **part = if replay.active {
+        Visibility::Inherited
+    } else {
+        Visibility::Hidden
+    };
+}
+
+fn draw_flags(
+    replay: Res<Replay>,
+    path: Res<ReplayPath>,
+    toolpath: Query<&ToolpathPath>,
+    mut gizmos: Gizmos,
+) {
+    let Some(tp) = toolpath.iter().next() else {
+        return;
+    };
+    if !replay.active {
+        return;
+    }
+    for e in path.passed_events() {
+        let Some(p) = tp.0.points.get(e.line) else {
+            continue;
+        };
+        let color = if e.what == clayloft_core::check::COLLISION {
+            Color::srgb(1.0, 0.1, 0.1)
+        } else {
+            Color::srgb(1.0, 0.6, 0.0)
+        };
+        gizmos.sphere(Isometry3d::from_translation(to_world(p.pos)), 1.2, color);
+    }
+}

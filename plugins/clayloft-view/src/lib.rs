@@ -1,0 +1,299 @@
+//! The 3D view (SPEC §8 "View"): an orbit camera, the printer's bed and build volume, the lofted
+//! wall coloured by overhang (violating regions in red), the spiral toolpath as lines and the
+//! control lines on the surface. It only reads the model's entities.
+
+use bevy::camera::visibility::Visibility;
+use bevy::picking::Pickable;
+use bevy::prelude::*;
+use bevy_panorbit_camera::{PanOrbitCamera, PanOrbitCameraPlugin};
+use clayloft_model::coords::to_world;
+use clayloft_model::preview::wall_buffers;
+use clayloft_model::*;
+
+/// What the view shows; the panels toggle these.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct ViewSettings {
+    pub show_wall: bool,
+    pub show_toolpath: bool,
+    pub show_control_lines: bool,
+    pub show_build_volume: bool,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings {
+            show_wall: true,
+            show_toolpath: false,
+            show_control_lines: true,
+            show_build_volume: true,
+        }
+    }
+}
+
+/// Marker of the wall mesh entity.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct WallView;
+
+/// Marker of the toolpath lines entity.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct ToolpathView;
+
+/// Marker of the bed entity.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct BedView;
+
+/// Number of wall points past the overhang limit (for the status line).
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct WallStats {
+    pub violating_points: usize,
+}
+
+/// The 3D view.
+pub struct ViewPlugin;
+
+impl Plugin for ViewPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<PanOrbitCameraPlugin>() {
+            app.add_plugins(PanOrbitCameraPlugin);
+        }
+        app.init_resource::<ViewSettings>()
+            .init_resource::<WallStats>()
+            .insert_resource(ClearColor(Color::srgb(0.13, 0.14, 0.16)))
+            .add_systems(Startup, spawn_scene)
+            .add_systems(
+                Update,
+                (
+                    frame_camera_on_first_surface,
+                    rebuild_wall_mesh,
+                    rebuild_toolpath_lines,
+                    update_bed,
+                    apply_view_settings,
+                    draw_build_volume,
+                    draw_control_lines,
+                )
+                    .in_set(ModelSystems::View),
+            );
+    }
+}
+
+fn spawn_scene(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut gizmo_assets: ResMut<Assets<GizmoAsset>>,
+) {
+    commands.spawn((
+        PanOrbitCamera {
+            focus: Vec3::new(90.0, 60.0, -95.0),
+            radius: Some(380.0),
+            yaw: Some(0.5),
+            pitch: Some(0.45),
+            ..default()
+        },
+        Transform::from_xyz(200.0, 200.0, 200.0),
+    ));
+    commands.insert_resource(GlobalAmbientLight {
+        color: Color::WHITE,
+        brightness: 180.0,
+        ..default()
+    });
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 9000.0,
+            shadow_maps_enabled: false,
+            ..default()
+        },
+        Transform::from_xyz(150.0, 300.0, 200.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 2500.0,
+            shadow_maps_enabled: false,
+            ..default()
+        },
+        Transform::from_xyz(-200.0, 100.0, -150.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    // The wall: vertex colours carry the overhang; both faces lit (the inside shows at the rim).
+    commands.spawn((
+        WallView,
+        Mesh3d(meshes.add(Mesh::from(Cuboid::new(0.0, 0.0, 0.0)))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::WHITE,
+            perceptual_roughness: 0.85,
+            double_sided: true,
+            cull_mode: None,
+            ..default()
+        })),
+        Pickable::IGNORE,
+        Name::new("wall view"),
+    ));
+    commands.spawn((
+        BedView,
+        Mesh3d(meshes.add(Cuboid::new(1.0, 1.0, 1.0))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.32, 0.34, 0.38),
+            perceptual_roughness: 0.95,
+            ..default()
+        })),
+        Transform::default(),
+        Pickable::IGNORE,
+        Name::new("bed"),
+    ));
+    commands.spawn((
+        ToolpathView,
+        Gizmo {
+            handle: gizmo_assets.add(GizmoAsset::new()),
+            line_config: GizmoLineConfig {
+                width: 1.5,
+                ..default()
+            },
+            depth_bias: -0.001,
+        },
+        Name::new("toolpath view"),
+    ));
+}
+
+/// Points the camera at the vessel the first time there is one.
+fn frame_camera_on_first_surface(
+    vessel: Query<&VesselSurface, Added<VesselSurface>>,
+    doc: Option<Res<DesignDoc>>,
+    mut camera: Query<&mut PanOrbitCamera>,
+    mut done: Local<bool>,
+) {
+    let (Some(surface), Some(doc)) = (vessel.iter().next(), doc) else {
+        return;
+    };
+    if *done {
+        return;
+    }
+    *done = true;
+    let h = doc.design.shape.height;
+    let focus = to_world(surface.0.center.extend(h * 0.4));
+    for mut cam in &mut camera {
+        cam.target_focus = focus;
+        cam.focus = focus;
+        let r = (h * 2.6).max(220.0) as f32;
+        cam.target_radius = r;
+        cam.radius = Some(r);
+        cam.force_update = true;
+    }
+}
+
+fn rebuild_wall_mesh(
+    vessel: Query<&VesselSurface, Changed<VesselSurface>>,
+    doc: Option<Res<DesignDoc>>,
+    wall: Single<&Mesh3d, With<WallView>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut stats: ResMut<WallStats>,
+) {
+    let (Some(surface), Some(doc)) = (vessel.iter().next(), doc) else {
+        return;
+    };
+    let buffers = wall_buffers(&surface.0, doc.design.printer.max_overhang_deg);
+    stats.violating_points = buffers.violating;
+    let _ = meshes.insert(wall.0.id(), buffers.into_mesh());
+}
+
+/// Retained gizmos ignore `Visibility`: a hidden toolpath is an empty line set.
+fn rebuild_toolpath_lines(
+    path: Query<Ref<ToolpathPath>>,
+    settings: Res<ViewSettings>,
+    view: Single<&Gizmo, With<ToolpathView>>,
+    mut assets: ResMut<Assets<GizmoAsset>>,
+) {
+    let Some(path) = path.iter().next() else {
+        return;
+    };
+    if !path.is_changed() && !settings.is_changed() {
+        return;
+    }
+    let mut asset = GizmoAsset::new();
+    if !settings.show_toolpath {
+        let _ = assets.insert(view.handle.id(), asset);
+        return;
+    }
+    let pts = &path.0.points;
+    let top = pts.iter().map(|p| p.pos.z).fold(1.0_f64, f64::max);
+    asset.linestrip_gradient(pts.iter().map(|p| {
+        let f = (p.pos.z / top) as f32;
+        (
+            to_world(p.pos),
+            Color::srgb(0.25 + 0.7 * f, 0.55 + 0.2 * (1.0 - f), 1.0 - 0.6 * f),
+        )
+    }));
+    let _ = assets.insert(view.handle.id(), asset);
+}
+
+fn update_bed(doc: Option<Res<DesignDoc>>, mut bed: Single<&mut Transform, With<BedView>>) {
+    let Some(doc) = doc else { return };
+    if !doc.is_changed() {
+        return;
+    }
+    let p = &doc.design.printer;
+    let (x, y) = (p.bed_x as f32, p.bed_y as f32);
+    // The bed's top face at z = 0; world (x, z, −y).
+    bed.translation = Vec3::new(x / 2.0, -1.0, -y / 2.0);
+    bed.scale = Vec3::new(x, 2.0, y);
+}
+
+fn apply_view_settings(
+    settings: Res<ViewSettings>,
+    mut wall: Query<&mut Visibility, With<WallView>>,
+) {
+    if !settings.is_changed() {
+        return;
+    }
+    let vis = |on: bool| {
+        if on {
+            Visibility::Inherited
+        } else {
+            Visibility::Hidden
+        }
+    };
+    for mut v in &mut wall {
+        *v = vis(settings.show_wall);
+    }
+}
+
+fn draw_build_volume(settings: Res<ViewSettings>, doc: Option<Res<DesignDoc>>, mut gizmos: Gizmos) {
+    let Some(doc) = doc else { return };
+    if !settings.show_build_volume {
+        return;
+    }
+    let p = &doc.design.printer;
+    let (x, y, z) = (p.bed_x as f32, p.bed_y as f32, p.max_z as f32);
+    let center = Vec3::new(x / 2.0, z / 2.0, -y / 2.0);
+    gizmos.cube(
+        Transform::from_translation(center).with_scale(Vec3::new(x, z, y)),
+        Color::srgba(0.6, 0.7, 0.9, 0.35),
+    );
+    // A 10 mm grid on the bed.
+    let color = Color::srgba(0.55, 0.58, 0.62, 0.5);
+    let mut gx = 0.0;
+    while gx <= x {
+        gizmos.line(Vec3::new(gx, 0.05, 0.0), Vec3::new(gx, 0.05, -y), color);
+        gx += 10.0;
+    }
+    let mut gy = 0.0;
+    while gy <= y {
+        gizmos.line(Vec3::new(0.0, 0.05, -gy), Vec3::new(x, 0.05, -gy), color);
+        gy += 10.0;
+    }
+}
+
+fn draw_control_lines(
+    settings: Res<ViewSettings>,
+    lines: Query<(&ControlLine, &ControlLineCurve)>,
+    mut gizmos: Gizmos,
+) {
+    if !settings.show_control_lines {
+        return;
+    }
+    for (line, curve) in &lines {
+        let color = match line.kind {
+            LineKind::Vertical => Color::srgb(0.2, 0.85, 0.95),
+            LineKind::Horizontal => Color::srgb(0.95, 0.4, 0.9),
+        };
+        gizmos.linestrip(curve.0.iter().map(|p| to_world(*p)), color);
+    }
+}
