@@ -38,6 +38,10 @@ fn drag_once(app: &mut App, sign: f64) {
         line: 0,
         point: 2,
     };
+    drag(app, role, DVec3::new(0.0, sign, 0.0));
+}
+
+fn drag(app: &mut App, role: HandleRole, delta: DVec3) {
     let world = app.world_mut();
     let offsets = world
         .query::<(&ContourRole, &ContourSamples)>()
@@ -48,12 +52,18 @@ fn drag_once(app: &mut App, sign: f64) {
     let mut doc = world.resource_mut::<DesignDoc>();
     let frame = handle_frame(role, &doc.design, &cache, &offsets).unwrap();
     let at = handle_position(role, &doc.design, &frame).unwrap();
-    set_handle(
-        role,
-        &mut doc.design,
-        &frame,
-        at + DVec3::new(0.0, sign, 0.0),
-    );
+    set_handle(role, &mut doc.design, &frame, at + delta);
+}
+
+fn rebuild_mesh(app: &mut App) {
+    let world = app.world_mut();
+    let surface = world
+        .query::<&VesselSurface>()
+        .single(world)
+        .unwrap()
+        .0
+        .clone();
+    std::hint::black_box(wall_buffers(&surface, 45.0).into_mesh());
 }
 
 fn bench(c: &mut Criterion) {
@@ -68,15 +78,20 @@ fn bench(c: &mut Criterion) {
             sign = -sign;
             drag_once(&mut app, sign);
             app.update();
-            let world = app.world_mut();
-            let surface = world
-                .query::<&VesselSurface>()
-                .single(world)
-                .unwrap()
-                .0
-                .clone();
-            let mesh = wall_buffers(&surface, 45.0).into_mesh();
-            std::hint::black_box(mesh);
+            rebuild_mesh(&mut app);
+        })
+    });
+    // A contour handle: resample that contour, rebuild the loft, reshape every section.
+    let radius = HandleRole::Contour {
+        contour: ContourRole::Upper,
+        param: clayloft_model::handles::ContourParam::Radius,
+    };
+    c.bench_function("drag_upper_contour_360x200_recompute_and_mesh", |b| {
+        b.iter(|| {
+            sign = -sign;
+            drag(&mut app, radius, DVec3::new(0.5 * sign, 0.0, 0.0));
+            app.update();
+            rebuild_mesh(&mut app);
         })
     });
 }
