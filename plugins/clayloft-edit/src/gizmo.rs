@@ -139,7 +139,6 @@ fn pointer_ray(
     Some((ray.origin, *ray.direction))
 }
 
-#[allow(clippy::too_many_arguments)]
 fn start_gizmo_drag(
     ev: On<Pointer<DragStart>>,
     parts: Query<&GizmoPart>,

@@ -21,6 +21,8 @@ pub struct EditInProgress(pub bool);
 pub struct PanelInUse {
     pub hovered: bool,
     pub editing: bool,
+    /// A text field has the keyboard: Ctrl+Z belongs to it, not to the design's history.
+    pub typing: bool,
 }
 
 /// Settled designs before and after the current one.
@@ -110,9 +112,13 @@ pub(crate) fn plugin(app: &mut App) {
 /// Ctrl+Z undoes, Ctrl+Shift+Z (or Ctrl+Y) redoes.
 fn read_history_keys(
     keys: Option<Res<ButtonInput<KeyCode>>>,
+    panel: Res<PanelInUse>,
     mut out: MessageWriter<HistoryCommand>,
 ) {
     let Some(keys) = keys else { return };
+    if panel.typing {
+        return;
+    }
     let ctrl = keys.any_pressed([
         KeyCode::ControlLeft,
         KeyCode::ControlRight,

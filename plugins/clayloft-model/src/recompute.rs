@@ -56,7 +56,6 @@ pub struct ToolpathMarker;
 
 /// Recomputes the derived entities when the design changed (change detection on
 /// [`DesignDoc`]); never runs otherwise.
-#[allow(clippy::too_many_arguments)]
 pub fn recompute_model(
     mut commands: Commands,
     doc: Option<Res<DesignDoc>>,

@@ -450,7 +450,7 @@ fn texture(ui: &mut egui::Ui, t: &mut Option<Texture>) {
     );
     let mut on = t.is_some();
     if ui.checkbox(&mut on, "textured").changed() {
-        *t = on.then(|| Texture {
+        *t = on.then_some(Texture {
             combine: Combine::Product,
             x: Some(Wave {
                 wave: WaveKind::Sine,

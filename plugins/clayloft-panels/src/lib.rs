@@ -22,7 +22,8 @@ pub struct FileFields {
     pub design: String,
     pub gcode: String,
     pub stl: String,
-    initialised: bool,
+    /// The document path the fields were filled from.
+    filled_from: Option<Option<PathBuf>>,
 }
 
 pub struct PanelsPlugin;
@@ -37,7 +38,6 @@ impl Plugin for PanelsPlugin {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
 fn draw_panels(
     mut contexts: EguiContexts,
     doc: Option<ResMut<DesignDoc>>,
@@ -58,8 +58,8 @@ fn draw_panels(
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let Some(mut doc) = doc else { return Ok(()) };
-    if !fields.initialised {
-        fields.initialised = true;
+    if fields.filled_from.as_ref() != Some(&doc.path) {
+        fields.filled_from = Some(doc.path.clone());
         let base = doc
             .path
             .clone()
@@ -196,6 +196,7 @@ fn draw_panels(
     }
     panel.hovered = ctx.egui_wants_pointer_input() || ctx.is_pointer_over_egui();
     panel.editing = ctx.egui_is_using_pointer();
+    panel.typing = ctx.egui_wants_keyboard_input();
     Ok(())
 }
 

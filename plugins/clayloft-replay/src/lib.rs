@@ -52,6 +52,27 @@ pub struct ReplayPath {
 }
 
 impl ReplayPath {
+    /// The replay of a toolpath: its timeline and every point the checker flags.
+    pub fn new(
+        path: &clayloft_core::toolpath::Toolpath,
+        printer: &clayloft_core::design::Printer,
+    ) -> ReplayPath {
+        let points: Vec<_> = path.points.iter().map(|p| p.pos).collect();
+        ReplayPath {
+            timeline: Timeline::new(path),
+            events: check_path(&points, &Limits::from(printer)).events,
+            index: 0,
+            passed: 0,
+        }
+    }
+
+    /// Moves the nozzle to print time `t` (s).
+    pub fn seek(&mut self, t: f64) {
+        self.index = self.timeline.index_at(t);
+        let index = self.index;
+        self.passed = self.events.partition_point(|e| e.line <= index);
+    }
+
     /// The events the nozzle has passed, most recent last.
     pub fn passed_events(&self) -> &[PathEvent] {
         &self.events[..self.passed]
@@ -213,11 +234,7 @@ fn prepare_replay_path(
     let (Some(path), Some(doc)) = (path.iter().next(), doc) else {
         return;
     };
-    let points: Vec<_> = path.0.points.iter().map(|p| p.pos).collect();
-    let report = check_path(&points, &Limits::from(&doc.design.printer));
-    replay_path.timeline = Timeline::new(&path.0);
-    replay_path.events = report.events;
-    replay_path.passed = 0;
+    *replay_path = ReplayPath::new(&path.0, &doc.design.printer);
     replay.time_s = replay.time_s.min(replay_path.timeline.total_s());
     if let Some(surface) = vessel.iter().next() {
         *source = PrintedSource {
@@ -237,10 +254,15 @@ fn advance_replay(time: Res<Time>, mut replay: ResMut<Replay>, mut path: ResMut<
             replay.playing = false;
         }
     }
-    let index = path.timeline.index_at(replay.time_s);
-    path.index = index;
-    path.passed = path.events.partition_point(|e| e.line <= index);
+    path.seek(replay.time_s);
 }
+
+/// A nozzle part, where it sits, and its material (the holder's turns red on a collision).
+type NozzlePartItem = (
+    &'static NozzlePart,
+    &'static mut Transform,
+    Option<&'static mut MeshMaterial3d<StandardMaterial>>,
+);
 
 fn follow_path(
     replay: Res<Replay>,
@@ -249,14 +271,7 @@ fn follow_path(
     doc: Option<Res<DesignDoc>>,
     look: Option<Res<NozzleLook>>,
     mut nozzle: Single<(&mut Transform, &mut Visibility), With<Nozzle>>,
-    mut parts: Query<
-        (
-            &NozzlePart,
-            &mut Transform,
-            Option<&mut MeshMaterial3d<StandardMaterial>>,
-        ),
-        Without<Nozzle>,
-    >,
+    mut parts: Query<NozzlePartItem, Without<Nozzle>>,
 ) {
     let (Some(tp), Some(doc), Some(look)) = (toolpath.iter().next(), doc, look) else {
         return;
@@ -388,5 +403,59 @@ fn draw_flags(
             Color::srgb(1.0, 0.6, 0.0)
         };
         gizmos.sphere(Isometry3d::from_translation(to_world(p.pos)), 1.2, color);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clayloft_core::check::{COLLISION, OVERHANG};
+
+    fn design(text: &str) -> clayloft_core::Design {
+        clayloft_core::load::parse_design(text).unwrap()
+    }
+
+    #[test]
+    fn a_clean_design_has_nothing_to_flag() {
+        let d = design(
+            "version = 1\n[shape]\nheight = 40.0\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 35.0 }\n",
+        );
+        let job = clayloft_core::run(&d).unwrap();
+        let mut r = ReplayPath::new(&job.toolpath, &d.printer);
+        assert!(r.events.is_empty());
+        r.seek(r.timeline.total_s());
+        assert_eq!(r.index, job.toolpath.points.len() - 1);
+        assert!(r.flag_now().is_none());
+    }
+
+    #[test]
+    fn overhangs_and_holder_collisions_are_flagged_as_the_nozzle_passes_them() {
+        // A bowl flaring at 53° with enforcement off, under a short nozzle and a wavy rim that
+        // rises 12 mm within a layer: overhangs, and the holder hits the rim's crests.
+        let d = design(
+            "version = 1\n[printer]\nnozzle_length = 8.0\n[shape]\nheight = 30.0\n\
+             lower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 70.0 }\n\
+             [[control.horizontal]]\nat = 1.0\nreach = 0.5\npoints = [[0.0, 0.0], [90.0, 12.0], [180.0, 0.0], [270.0, 12.0]]\n\
+             [constraints]\nenforce = false\n",
+        );
+        let job = clayloft_core::run(&d).unwrap();
+        let mut r = ReplayPath::new(&job.toolpath, &d.printer);
+        let overhangs = r.events.iter().filter(|e| e.what == OVERHANG).count();
+        assert!(overhangs > 100, "{overhangs}");
+        assert!(r.events.iter().any(|e| e.what == COLLISION));
+        assert!(r.events.windows(2).all(|w| w[0].line <= w[1].line));
+        // Before the first flagged point nothing is passed; just after it, it is flagged now.
+        let first = r.events[0];
+        r.seek(0.0);
+        assert_eq!(r.passed, 0);
+        let t_first = r.timeline.time_of(first.line);
+        r.seek(t_first);
+        assert!(r.passed >= 1);
+        assert_eq!(
+            r.flag_now().map(|e| e.line),
+            Some(r.events[r.passed - 1].line)
+        );
+        r.seek(r.timeline.total_s());
+        assert_eq!(r.passed, r.events.len());
     }
 }

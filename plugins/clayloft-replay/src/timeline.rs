@@ -28,6 +28,11 @@ impl Timeline {
         self.times.last().copied().unwrap_or(0.0)
     }
 
+    /// Print time when the nozzle reaches point `j`, s.
+    pub fn time_of(&self, j: usize) -> f64 {
+        self.times.get(j).copied().unwrap_or_else(|| self.total_s())
+    }
+
     /// Index of the last point reached at time `t`.
     pub fn index_at(&self, t: f64) -> usize {
         self.times.partition_point(|x| *x <= t).saturating_sub(1)
@@ -70,6 +75,7 @@ mod tests {
         };
         let tl = Timeline::new(&path);
         assert_eq!(tl.total_s(), 2.0);
+        assert_eq!(tl.time_of(1), 1.0);
         assert_eq!(tl.index_at(0.5), 0);
         assert_eq!(tl.index_at(1.0), 1);
         assert_eq!(tl.index_at(99.0), 2);
