@@ -328,7 +328,7 @@ fn bad_design_files() {
             "type = \"image\"\npath = \"leaf.png\"\nsize = 80.0",
         )
         .as_bytes(),
-        &["not supported yet"],
+        &["shape.lower", "leaf.png", "no such file"],
     );
     bad_design(
         GOOD.replace(
@@ -425,4 +425,56 @@ fn editor_and_screenshot_reject_bad_input_before_opening_a_window() {
     ]);
     assert_bad_input(&out, &["/nonexistent/vase.toml"]);
     assert!(!png.exists());
+}
+
+#[test]
+fn bad_pictures_and_drawings_exit_2_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // An all-white PNG (8 × 8 grey), a text file posing as a picture, an SVG without paths.
+    image::GrayImage::from_pixel(8, 8, image::Luma([255]))
+        .save(d.join("white.png"))
+        .unwrap();
+    std::fs::write(d.join("notes.png"), "shopping list").unwrap();
+    std::fs::write(
+        d.join("empty.svg"),
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="9" height="9"/>"#,
+    )
+    .unwrap();
+    for (contour, why) in [
+        (
+            "type = \"image\"\npath = \"missing.png\"\nsize = 80.0",
+            vec!["missing.png", "no such file"],
+        ),
+        (
+            "type = \"image\"\npath = \"white.png\"\nsize = 80.0",
+            vec!["white.png"],
+        ),
+        (
+            "type = \"image\"\npath = \"notes.png\"\nsize = 80.0",
+            vec!["notes.png", "not a picture"],
+        ),
+        (
+            "type = \"svg\"\npath = \"empty.svg\"\nsize = 80.0",
+            vec!["empty.svg", "no closed path"],
+        ),
+    ] {
+        let design = d.join("bad.toml");
+        std::fs::write(
+            &design,
+            GOOD.replace("type = \"circle\"\nradius = 40.0", contour),
+        )
+        .unwrap();
+        let out_path = d.join("out.gcode");
+        let out = clayloft(&[
+            "gcode",
+            design.to_str().unwrap(),
+            "-o",
+            out_path.to_str().unwrap(),
+        ]);
+        let mut needles = vec!["bad.toml", "shape.lower"];
+        needles.extend(why);
+        assert_bad_input(&out, &needles);
+        assert!(!out_path.exists());
+    }
 }

@@ -3,6 +3,7 @@
 //! rejected.
 
 use std::f64::consts::{PI, TAU};
+use std::path::Path;
 
 use glam::DVec2;
 
@@ -29,14 +30,32 @@ pub enum ContourError {
     ZeroArea,
     #[error("the contour crosses itself (near ({x:.1}, {y:.1}) mm)")]
     SelfIntersecting { x: f64, y: f64 },
-    #[error("{0} contours are not supported yet")]
-    Unsupported(&'static str),
+    #[error("{file}: {reason}")]
+    Image {
+        file: String,
+        reason: crate::trace::TraceError,
+    },
+    #[error("{file}: {reason}")]
+    Svg {
+        file: String,
+        reason: crate::svg::SvgError,
+    },
 }
 
 impl Contour {
     /// Builds the contour described by `spec`, normalised to counter-clockwise order.
     /// `dense` is the number of points used for smooth curves (at least [`DENSE_POINTS`] is wise).
     pub fn from_spec(spec: &ContourSpec, dense: usize) -> Result<Contour, ContourError> {
+        Contour::from_spec_in(spec, dense, None)
+    }
+
+    /// As [`Contour::from_spec`], with image and SVG paths relative to `base` (the design file's
+    /// folder).
+    pub fn from_spec_in(
+        spec: &ContourSpec,
+        dense: usize,
+        base: Option<&Path>,
+    ) -> Result<Contour, ContourError> {
         let raw = match spec {
             ContourSpec::Circle { radius } => polar(dense, |_| *radius),
             ContourSpec::Ellipse { rx, ry } => (0..dense)
@@ -82,8 +101,9 @@ impl Contour {
                 let per_span = (dense / ctrl.len()).clamp(8, 256);
                 closed_catmull_rom(&ctrl, per_span)
             }
-            ContourSpec::Image { .. } => return Err(ContourError::Unsupported("image")),
-            ContourSpec::Svg { .. } => return Err(ContourError::Unsupported("svg")),
+            ContourSpec::Image { .. } | ContourSpec::Svg { .. } => {
+                crate::outline::outline_of(spec, base)?
+            }
         };
         Contour::from_points(raw)
     }

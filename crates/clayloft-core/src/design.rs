@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 pub const DESIGN_VERSION: u32 = 1;
 
 /// A whole design: printer, shape, control lines, texture and constraint policy.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Design {
     pub version: u32,
@@ -26,6 +26,23 @@ pub struct Design {
     pub texture: Option<Texture>,
     #[serde(default)]
     pub constraints: Constraints,
+    /// Folder that image and SVG contour paths are relative to: the design file's (set by the
+    /// loader; not part of the file, not compared).
+    #[serde(skip)]
+    pub base_dir: Option<std::path::PathBuf>,
+}
+
+/// Two designs are equal when their files would say the same (the folder they came from aside).
+impl PartialEq for Design {
+    fn eq(&self, o: &Design) -> bool {
+        self.version == o.version
+            && self.name == o.name
+            && self.printer == o.printer
+            && self.shape == o.shape
+            && self.control == o.control
+            && self.texture == o.texture
+            && self.constraints == o.constraints
+    }
 }
 
 fn default_name() -> String {
@@ -165,15 +182,22 @@ pub enum ContourSpec {
     Spline {
         points: Vec<[f64; 2]>,
     },
-    /// Outline traced from a picture (not supported yet).
+    /// Outline of the largest shape in a picture (PNG, JPEG, …), longer side `size` mm. `path`
+    /// is relative to the design file. `threshold` (grey level 0–255) overrides Otsu's automatic
+    /// one.
     Image {
         path: String,
         size: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        threshold: Option<u8>,
     },
-    /// Outline read from an SVG path (not supported yet).
+    /// The first closed path of an SVG drawing (or the path `id`), longer side `size` mm. `path`
+    /// is relative to the design file.
     Svg {
         path: String,
         size: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        id: Option<String>,
     },
 }
 

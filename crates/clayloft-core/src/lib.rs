@@ -2,7 +2,8 @@
 //!
 //! The pipeline, in order (each stage a function from plain data to plain data):
 //! 1. [`load`] reads and [`validate`]s a [`design::Design`] (SPEC §6);
-//! 2. [`contour`] builds the two closed curves ([`spline`] for user splines), [`align`] puts their
+//! 2. [`contour`] builds the two closed curves ([`spline`] for user splines, [`trace`] for
+//!    pictures, [`svg`] for drawings, through [`outline`]), [`align`] puts their
 //!    anchors on the design centre, [`sample`] samples them by arc length and corresponds them;
 //! 3. [`loft`] interpolates between them, [`shape`] adds the [`control`] lines section by
 //!    [`section`] on a layer plan that keeps layer heights printable;
@@ -24,6 +25,7 @@ pub mod geometry;
 pub mod interp;
 pub mod load;
 pub mod loft;
+pub mod outline;
 pub mod pipeline;
 pub mod report;
 pub mod sample;
@@ -31,8 +33,10 @@ pub mod section;
 pub mod shape;
 pub mod spline;
 pub mod stl;
+pub mod svg;
 pub mod texture;
 pub mod toolpath;
+pub mod trace;
 pub mod validate;
 
 pub use design::Design;

@@ -66,7 +66,7 @@ pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
     let bytes = std::fs::read(path).map_err(|e| read_err(io_reason(&e)))?;
     let source = String::from_utf8(bytes)
         .map_err(|_| read_err("it is not a text (UTF-8) file — is it a design?".into()))?;
-    let design = parse_design(&source).map_err(|e| match e {
+    let mut design = parse_design(&source).map_err(|e| match e {
         ParseError::Syntax { line, message } => DesignError::Syntax {
             file: file.clone(),
             line,
@@ -74,6 +74,10 @@ pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
         },
         ParseError::Field(f) => located(path, &source, f),
     })?;
+    design.base_dir = Some(match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    });
     Ok(LoadedDesign {
         design,
         path: path.to_path_buf(),
@@ -288,16 +292,18 @@ mod tests {
     }
 
     #[test]
-    fn image_contour_is_not_supported_yet() {
+    fn image_contour_size_is_checked_and_its_folder_remembered() {
         let src = MINIMAL.replace(
             "type = \"circle\"\nradius = 40.0",
-            "type = \"image\"\npath = \"leaf.png\"\nsize = 80.0",
+            "type = \"image\"\npath = \"leaf.png\"\nsize = -80.0",
         );
         let e = load_str(&src).to_string();
-        assert!(
-            e.contains("shape.lower.type") && e.contains("not supported yet"),
-            "{e}"
-        );
+        assert!(e.contains("shape.lower.size") && e.contains("-80"), "{e}");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("d.toml");
+        std::fs::write(&path, MINIMAL).unwrap();
+        let loaded = load_design(&path).unwrap();
+        assert_eq!(loaded.design.base_dir.as_deref(), Some(dir.path()));
     }
 
     #[test]

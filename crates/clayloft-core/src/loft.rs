@@ -33,13 +33,15 @@ pub struct SampledContour {
 }
 
 /// Builds, aligns and samples one contour of the design.
+/// Image and SVG paths are relative to `base` (the design file's folder).
 pub fn sample_contour(
     spec: &ContourSpec,
     field: &str,
     center: DVec2,
     samples: usize,
+    base: Option<&std::path::Path>,
 ) -> Result<SampledContour, FieldError> {
-    let contour = Contour::from_spec(spec, DENSE_POINTS.max(4 * samples))
+    let contour = Contour::from_spec_in(spec, DENSE_POINTS.max(4 * samples), base)
         .map_err(|e: ContourError| FieldError::new(field, e.to_string()))?;
     let offset = center - anchor(&contour);
     let aligned = contour.translated(offset);
@@ -56,7 +58,7 @@ pub fn sampled_contour(
     center: DVec2,
     samples: usize,
 ) -> Result<Vec<DVec2>, FieldError> {
-    sample_contour(spec, field, center, samples).map(|c| c.samples)
+    sample_contour(spec, field, center, samples, None).map(|c| c.samples)
 }
 
 impl LoftInput {
@@ -65,8 +67,9 @@ impl LoftInput {
         let [cx, cy] = design.center();
         let center = DVec2::new(cx, cy);
         let n = design.shape.samples;
-        let lower = sampled_contour(&design.shape.lower, "shape.lower", center, n)?;
-        let upper = sampled_contour(&design.shape.upper, "shape.upper", center, n)?;
+        let base = design.base_dir.as_deref();
+        let lower = sample_contour(&design.shape.lower, "shape.lower", center, n, base)?.samples;
+        let upper = sample_contour(&design.shape.upper, "shape.upper", center, n, base)?.samples;
         Ok(LoftInput::from_samples(lower, upper, center))
     }
 

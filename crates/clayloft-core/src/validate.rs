@@ -407,13 +407,17 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             }
             Ok(())
         }
-        ContourSpec::Image { .. } => Err(FieldError::new(
-            fld("type"),
-            "image contours are not supported yet (planned); use spline points traced from the picture",
-        )),
-        ContourSpec::Svg { .. } => Err(FieldError::new(
-            fld("type"),
-            "svg contours are not supported yet (planned); use spline points from the outline",
-        )),
+        ContourSpec::Image { path, size, .. } | ContourSpec::Svg { path, size, .. } => {
+            if path.trim().is_empty() {
+                return Err(FieldError::new(fld("path"), "names no file"));
+            }
+            in_range(
+                &fld("size"),
+                *size,
+                1.0,
+                MAX_LENGTH,
+                "mm across the longer side",
+            )
+        }
     }
 }

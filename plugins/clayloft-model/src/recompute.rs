@@ -92,7 +92,13 @@ pub fn recompute_model(
     let mut new_samples = Vec::new();
     for role in &resample {
         let spec = crate::handles::contour_spec(design, *role);
-        match sample_contour(spec, role.field(), center, design.shape.samples) {
+        match sample_contour(
+            spec,
+            role.field(),
+            center,
+            design.shape.samples,
+            design.base_dir.as_deref(),
+        ) {
             Ok(c) => new_samples.push((*role, c)),
             Err(e) => {
                 status.error = Some(e.to_string());

@@ -124,6 +124,13 @@ fn contour_kind(spec: &ContourSpec) -> &'static str {
     }
 }
 
+fn file_field(ui: &mut egui::Ui, path: &mut String, help: &str) {
+    ui.horizontal(|ui| {
+        ui.label("File").on_hover_text(help);
+        ui.text_edit_singleline(path).on_hover_text(help);
+    });
+}
+
 fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
     let kind = contour_kind(spec);
     egui::ComboBox::from_id_salt(format!("{id} kind"))
@@ -167,6 +174,22 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
                     "spline",
                     ContourSpec::Spline {
                         points: vec![[r, 0.0], [0.0, r], [-r, 0.0], [0.0, -r]],
+                    },
+                ),
+                (
+                    "image",
+                    ContourSpec::Image {
+                        path: "outline.png".into(),
+                        size: 2.0 * r,
+                        threshold: None,
+                    },
+                ),
+                (
+                    "svg",
+                    ContourSpec::Svg {
+                        path: "outline.svg".into(),
+                        size: 2.0 * r,
+                        id: None,
                     },
                 ),
             ];
@@ -272,19 +295,61 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
                 3,
             );
         }
-        ContourSpec::Image { path, size } | ContourSpec::Svg { path, size } => {
-            ui.horizontal(|ui| {
-                ui.label("File");
-                ui.text_edit_singleline(path);
-            });
+        ContourSpec::Image {
+            path,
+            size,
+            threshold,
+        } => {
+            file_field(
+                ui,
+                path,
+                "Picture (PNG, JPEG, …), relative to the design file. The largest shape's outline is traced.",
+            );
             number(
                 ui,
                 "Size",
                 size,
                 "mm",
                 1.0..=1000.0,
-                "Length of the longer side.",
+                "Length of the outline's longer side.",
             );
+            let mut manual = threshold.is_some();
+            if ui
+                .checkbox(&mut manual, "manual threshold")
+                .on_hover_text("Off: Otsu's method picks the grey level that best separates shape and background.")
+                .changed()
+            {
+                *threshold = manual.then_some(128);
+            }
+            if let Some(t) = threshold {
+                ui.add(egui::Slider::new(t, 0..=255).text("grey level"))
+                    .on_hover_text(
+                        "Pixels on the shape's side of this grey level belong to the shape.",
+                    );
+            }
+        }
+        ContourSpec::Svg { path, size, id } => {
+            file_field(
+                ui,
+                path,
+                "SVG drawing, relative to the design file. Its first closed path is used.",
+            );
+            number(
+                ui,
+                "Size",
+                size,
+                "mm",
+                1.0..=1000.0,
+                "Length of the outline's longer side.",
+            );
+            let mut text = id.clone().unwrap_or_default();
+            ui.horizontal(|ui| {
+                ui.label("Path id")
+                    .on_hover_text("Use the path with this id instead of the first closed one.");
+                if ui.text_edit_singleline(&mut text).changed() {
+                    *id = (!text.trim().is_empty()).then(|| text.trim().to_string());
+                }
+            });
         }
     }
 }

@@ -3,6 +3,7 @@
 //! and a status line. Panels edit the design document only; everything else follows from it.
 
 mod design_form;
+mod source_preview;
 mod widgets;
 
 use std::path::PathBuf;
@@ -33,8 +34,10 @@ impl Plugin for PanelsPlugin {
         if !app.is_plugin_added::<EguiPlugin>() {
             app.add_plugins(EguiPlugin::default());
         }
-        app.init_resource::<FileFields>()
-            .add_systems(EguiPrimaryContextPass, draw_panels);
+        app.init_resource::<FileFields>().add_systems(
+            EguiPrimaryContextPass,
+            (draw_panels, draw_source_previews).chain(),
+        );
     }
 }
 
@@ -197,6 +200,19 @@ fn draw_panels(
     panel.hovered = ctx.egui_wants_pointer_input() || ctx.is_pointer_over_egui();
     panel.editing = ctx.egui_is_using_pointer();
     panel.typing = ctx.egui_wants_keyboard_input();
+    Ok(())
+}
+
+/// The image / SVG source windows of the contours.
+fn draw_source_previews(
+    mut contexts: EguiContexts,
+    doc: Option<Res<DesignDoc>>,
+    mut previews: Local<[source_preview::SourcePreview; 2]>,
+) -> Result {
+    let ctx = contexts.ctx_mut()?.clone();
+    if let Some(doc) = doc {
+        source_preview::source_windows(&ctx, &doc.design, &mut previews);
+    }
     Ok(())
 }
 

@@ -172,7 +172,16 @@ fn frame_camera_on_first_surface(
     for mut cam in &mut camera {
         cam.target_focus = focus;
         cam.focus = focus;
-        let r = (h * 2.6).max(220.0) as f32;
+        let (mut lo, mut hi) = (
+            bevy::math::DVec2::splat(f64::MAX),
+            bevy::math::DVec2::splat(f64::MIN),
+        );
+        for q in surface.0.sections.iter().flat_map(|s| &s.points) {
+            lo = lo.min(q.truncate());
+            hi = hi.max(q.truncate());
+        }
+        let extent = (hi - lo).max_element().max(h);
+        let r = (extent * 2.4).max(200.0) as f32;
         cam.target_radius = r;
         cam.radius = Some(r);
         cam.force_update = true;
