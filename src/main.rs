@@ -4,6 +4,7 @@
 //! 2 = bad input).
 
 mod app;
+mod printer;
 mod screenshot;
 
 use std::path::{Path, PathBuf};
@@ -63,6 +64,36 @@ enum Command {
         #[arg(long, default_value_t = 720)]
         height: u32,
     },
+    /// Stream a G-code file to a printer (Marlin protocol) with a progress bar.
+    Print {
+        gcode: PathBuf,
+        /// Serial port, e.g. /dev/ttyUSB0 (or the path `clayloft fake-printer` prints).
+        #[arg(long)]
+        port: String,
+        #[arg(long, default_value_t = 115_200)]
+        baud: u32,
+        /// Seconds of silence before the printer is probed with M105.
+        #[arg(long, default_value_t = 10.0)]
+        timeout: f64,
+    },
+    /// Play a Marlin printer on a pseudo-terminal (prints its path), with injected faults.
+    FakePrinter {
+        /// Fraction of lines with a fault (0–0.5), spread over resends, corrupted bytes, lost oks,
+        /// busy periods, slow replies and resends without ok.
+        #[arg(long, default_value_t = 0.0)]
+        faults: f64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Reboot (print `start`) after this many accepted commands.
+        #[arg(long)]
+        reset_after: Option<u64>,
+        /// Make the port disappear after this many accepted commands.
+        #[arg(long)]
+        vanish_after: Option<u64>,
+        /// Write every accepted command to this file when the host disconnects.
+        #[arg(long)]
+        log: Option<PathBuf>,
+    },
     /// Re-measure a G-code file against the printer limits (exit 0 = all hold, 1 = violations).
     Check {
         gcode: PathBuf,
@@ -87,6 +118,25 @@ fn main() -> ExitCode {
         Some(Command::Gcode { design, out }) => gcode(&design, &out),
         Some(Command::Stl { design, out, ascii }) => stl(&design, &out, ascii),
         Some(Command::Check { gcode, design }) => check(&gcode, design.as_deref()),
+        Some(Command::Print {
+            gcode,
+            port,
+            baud,
+            timeout,
+        }) => printer::print(&gcode, &port, baud, timeout),
+        Some(Command::FakePrinter {
+            faults,
+            seed,
+            reset_after,
+            vanish_after,
+            log,
+        }) => printer::fake_printer(printer::FakeOptions {
+            faults,
+            seed,
+            reset_after,
+            vanish_after,
+            log,
+        }),
         Some(Command::Info { design }) => overview(&design.unwrap_or_else(default_design)),
         Some(Command::Screenshot {
             design,
