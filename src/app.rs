@@ -39,6 +39,7 @@ pub fn run(design: Design, path: PathBuf, screenshot: Option<ScreenshotRequest>)
         clayloft_files::FilesPlugin,
         clayloft_replay::ReplayPlugin,
         clayloft_panels::PanelsPlugin,
+        clayloft_printer::PrinterPlugin,
     ));
     let screenshot_mode = screenshot.is_some();
     if let Some(req) = screenshot {

@@ -1,0 +1,327 @@
+//! The printer panel (SPEC §8, §9): list ports, print the current design on one (the serial link
+//! runs on a background thread and talks to the ECS through channels), pause, resume, cancel,
+//! emergency stop; progress, temperatures and the printer's messages; the replay nozzle in the
+//! 3D view follows the line being printed. Try it against `clayloft fake-printer`.
+
+use std::collections::VecDeque;
+use std::sync::Mutex;
+use std::sync::mpsc::{Receiver, Sender as Tx, channel};
+use std::time::Instant;
+
+use bevy::prelude::*;
+use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
+use clayloft_model::DesignDoc;
+use clayloft_replay::{Replay, ReplayPath};
+use clayloft_serial::line::commands;
+use clayloft_serial::link::{list_ports, open_port, run_job};
+use clayloft_serial::reply::Temperatures;
+use clayloft_serial::sender::State;
+use clayloft_serial::{Event, Sender, SenderConfig};
+
+/// What the panel asks the link thread to do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Control {
+    Pause,
+    Resume,
+    Cancel,
+    EmergencyStop,
+}
+
+/// What the link thread reports.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LinkEvent {
+    Event(Event),
+    /// The job ended: finished, or why not.
+    Ended(Result<(), String>),
+}
+
+/// A job running on its thread.
+pub struct Job {
+    control: Tx<Control>,
+    events: Mutex<Receiver<LinkEvent>>,
+    /// Toolpath point of each stripped G-code command (`None` before the first move).
+    point_of_command: Vec<usize>,
+    paused: bool,
+}
+
+/// The printer panel's state.
+#[derive(Resource, Default)]
+pub struct PrinterPanel {
+    pub port: String,
+    pub baud: u32,
+    pub ports: Vec<String>,
+    pub job: Option<Job>,
+    pub done: usize,
+    pub total: usize,
+    pub started: Option<Instant>,
+    pub temperatures: Option<Temperatures>,
+    pub messages: VecDeque<String>,
+    pub status: Option<(String, bool)>,
+}
+
+pub struct PrinterPlugin;
+
+impl Plugin for PrinterPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(PrinterPanel {
+            baud: 115_200,
+            ports: list_ports(),
+            ..default()
+        })
+        .add_systems(Update, pump_link_events)
+        .add_systems(EguiPrimaryContextPass, draw_printer_window);
+    }
+}
+
+/// Toolpath point index of every command: the k-th extruding `G1` is point k.
+pub fn points_of_commands(cmds: &[String]) -> Vec<usize> {
+    let mut k = 0usize;
+    cmds.iter()
+        .map(|c| {
+            let here = k;
+            if c.starts_with("G1 ") && c.contains(" E") {
+                k += 1;
+            }
+            here
+        })
+        .collect()
+}
+
+/// Starts printing `design` on `port`: G-code from the core, streamed on a background thread.
+pub fn start_job(design: &clayloft_core::Design, port: &str, baud: u32) -> Result<Job, String> {
+    let job = clayloft_core::run(design).map_err(|e| e.to_string())?;
+    let mut bytes = Vec::new();
+    clayloft_core::gcode::write_gcode(design, &job, &mut bytes).map_err(|e| e.to_string())?;
+    let cmds = commands(&String::from_utf8_lossy(&bytes));
+    let point_of_command = points_of_commands(&cmds);
+    let mut sender =
+        Sender::new(cmds, SenderConfig::default(), Instant::now()).map_err(|e| e.to_string())?;
+    let mut link = open_port(port, baud)?;
+    let (control_tx, control_rx) = channel::<Control>();
+    let (event_tx, event_rx) = channel::<LinkEvent>();
+    std::thread::spawn(move || {
+        let tx = event_tx.clone();
+        run_job(
+            link.as_mut(),
+            &mut sender,
+            |ev| {
+                let _ = tx.send(LinkEvent::Event(ev.clone()));
+            },
+            |s| {
+                while let Ok(c) = control_rx.try_recv() {
+                    match c {
+                        Control::Pause => s.pause(),
+                        Control::Resume => s.resume(),
+                        Control::Cancel => s.cancel(),
+                        Control::EmergencyStop => s.emergency_stop(),
+                    }
+                }
+            },
+        );
+        let end = match sender.state() {
+            State::Finished => Ok(()),
+            State::Failed(why) => Err(why.clone()),
+            State::Cancelled => Err("cancelled".into()),
+            other => Err(format!("{other:?}")),
+        };
+        let _ = event_tx.send(LinkEvent::Ended(end));
+    });
+    Ok(Job {
+        control: control_tx,
+        events: Mutex::new(event_rx),
+        point_of_command,
+        paused: false,
+    })
+}
+
+/// Brings the link thread's news into the panel, and moves the replay nozzle to the line being
+/// printed.
+fn pump_link_events(
+    mut panel: ResMut<PrinterPanel>,
+    mut replay: ResMut<Replay>,
+    path: Res<ReplayPath>,
+) {
+    let Some(job) = &panel.job else { return };
+    let news: Vec<LinkEvent> = match job.events.lock() {
+        Ok(rx) => rx.try_iter().collect(),
+        Err(_) => return,
+    };
+    for n in news {
+        match n {
+            LinkEvent::Event(Event::Progress { done, total }) => {
+                panel.done = done;
+                panel.total = total;
+                let point = panel
+                    .job
+                    .as_ref()
+                    .and_then(|j| j.point_of_command.get(done.saturating_sub(1)).copied())
+                    .unwrap_or(0);
+                replay.active = true;
+                replay.playing = false;
+                replay.time_s = path.timeline.time_of(point);
+            }
+            LinkEvent::Event(Event::Temperatures(t)) => panel.temperatures = Some(t),
+            LinkEvent::Event(Event::Message(m)) => {
+                panel.messages.push_back(m);
+                while panel.messages.len() > 200 {
+                    panel.messages.pop_front();
+                }
+            }
+            LinkEvent::Event(_) => {}
+            LinkEvent::Ended(r) => {
+                panel.status = Some(match r {
+                    Ok(()) => (format!("printed all {} lines", panel.total), false),
+                    Err(why) => (why, true),
+                });
+                panel.job = None;
+            }
+        }
+    }
+}
+
+fn draw_printer_window(
+    mut contexts: EguiContexts,
+    mut panel: ResMut<PrinterPanel>,
+    doc: Option<Res<DesignDoc>>,
+) -> Result {
+    let ctx = contexts.ctx_mut()?.clone();
+    egui::Window::new("Printer")
+        .default_open(false)
+        .default_pos(egui::pos2(760.0, 640.0))
+        .show(&ctx, |ui| {
+            ui.label(egui::RichText::new("Streams the design's G-code line by line (Marlin protocol: numbered lines, checksums, resends). Try it on `clayloft fake-printer`.").small().weak());
+            ui.horizontal(|ui| {
+                ui.label("Port");
+                egui::ComboBox::from_id_salt("ports").selected_text(panel.port.clone()).show_ui(ui, |ui| {
+                    let ports = panel.ports.clone();
+                    for p in ports {
+                        ui.selectable_value(&mut panel.port, p.clone(), p);
+                    }
+                });
+                if ui.small_button("↻").on_hover_text("list the ports again").clicked() {
+                    panel.ports = list_ports();
+                }
+            });
+            ui.horizontal(|ui| {
+                ui.label("or path");
+                ui.text_edit_singleline(&mut panel.port);
+            });
+            ui.horizontal(|ui| {
+                ui.label("Baud");
+                ui.add(egui::DragValue::new(&mut panel.baud).range(9600..=1_000_000));
+            });
+            let running = panel.job.is_some();
+            ui.horizontal(|ui| {
+                if ui.add_enabled(!running && !panel.port.is_empty(), egui::Button::new("▶ Print design")).clicked()
+                    && let Some(doc) = &doc
+                {
+                    match start_job(&doc.design, &panel.port.clone(), panel.baud) {
+                        Ok(job) => {
+                            panel.job = Some(job);
+                            panel.done = 0;
+                            panel.started = Some(Instant::now());
+                            panel.status = Some((format!("printing on {}", panel.port), false));
+                        }
+                        Err(e) => panel.status = Some((e, true)),
+                    }
+                }
+                if let Some(job) = &mut panel.job {
+                    let label = if job.paused { "resume" } else { "pause" };
+                    if ui.button(label).clicked() {
+                        let _ = job.control.send(if job.paused { Control::Resume } else { Control::Pause });
+                        job.paused = !job.paused;
+                    }
+                    if ui.button("cancel").clicked() {
+                        let _ = job.control.send(Control::Cancel);
+                    }
+                    if ui.button(egui::RichText::new("EMERGENCY STOP").color(egui::Color32::RED)).on_hover_text("M112: the printer halts at once").clicked() {
+                        let _ = job.control.send(Control::EmergencyStop);
+                    }
+                }
+            });
+            if panel.total > 0 {
+                let f = panel.done as f32 / panel.total as f32;
+                let eta = panel.started.filter(|_| f > 0.0).map(|t| t.elapsed().as_secs_f32() * (1.0 - f) / f);
+                ui.add(egui::ProgressBar::new(f).text(format!(
+                    "{}/{} lines{}",
+                    panel.done,
+                    panel.total,
+                    eta.map(|e| format!(", {:.0} s left", e)).unwrap_or_default()
+                )));
+            }
+            if let Some(t) = panel.temperatures {
+                let show = |v: Option<(f64, f64)>| v.map(|(a, b)| format!("{a:.1}/{b:.0} °C")).unwrap_or("–".into());
+                ui.label(format!("nozzle {}   bed {}", show(t.tool), show(t.bed)));
+            }
+            if let Some((m, err)) = &panel.status {
+                let c = if *err { egui::Color32::from_rgb(255, 90, 90) } else { egui::Color32::from_rgb(150, 220, 150) };
+                ui.colored_label(c, m);
+            }
+            egui::ScrollArea::vertical().max_height(120.0).stick_to_bottom(true).show(ui, |ui| {
+                for m in &panel.messages {
+                    ui.monospace(m);
+                }
+            });
+        });
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn commands_map_to_toolpath_points() {
+        let cmds: Vec<String> = [
+            "G21",
+            "G0 X1 Y1 Z1",
+            "G1 X2 Y1 E0.1 F600",
+            "G1 X3 Y1 E0.1",
+            "G0 Z20",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        assert_eq!(points_of_commands(&cmds), vec![0, 0, 0, 1, 2]);
+    }
+
+    #[test]
+    fn a_job_streams_to_a_fake_printer_on_its_thread() {
+        use clayloft_serial::fake::{FakePrinter, Faults};
+        use clayloft_serial::link::serve_fake;
+        use serialport::{SerialPort, TTYPort};
+        let (mut master, slave) = TTYPort::pair().unwrap();
+        master
+            .set_timeout(std::time::Duration::from_millis(5))
+            .unwrap();
+        let name = slave.name().unwrap();
+        drop(slave);
+        let fake = std::thread::spawn(move || {
+            serve_fake(
+                &mut master as &mut dyn SerialPort,
+                FakePrinter::new(Faults::default()),
+                |_| false,
+            )
+        });
+        let design = clayloft_core::load::parse_design(
+            "version = 1\n[shape]\nheight = 5.0\nsamples = 24\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
+        )
+        .unwrap();
+        let job = start_job(&design, &name, 115_200).unwrap();
+        let rx = job.events.lock().unwrap();
+        let end = loop {
+            match rx
+                .recv_timeout(std::time::Duration::from_secs(20))
+                .expect("no hang")
+            {
+                LinkEvent::Ended(r) => break r,
+                LinkEvent::Event(_) => {}
+            }
+        };
+        assert_eq!(end, Ok(()));
+        drop(rx);
+        drop(job);
+        let printer = fake.join().unwrap();
+        assert!(printer.log.iter().filter(|c| c.starts_with("G1 ")).count() > 24 * 5);
+    }
+}
