@@ -1,0 +1,249 @@
+//! The D2Q9 BGK solver (the paper's equations 1–5): pull streaming and collision fused in one
+//! pass over two lattices; half-way bounce-back at walls half a cell outside the boundary nodes;
+//! the moving lid by Ladd's rule `fᵢ = f*_ī + 6wᵢρ cᵢ·u_w`; a periodic channel with Guo's body
+//! force; a per-cell relaxation time from the strain rate of the non-equilibrium moments.
+
+use crate::lattice::{C, OPP, W, equilibrium};
+use crate::rheology::{Fluid, tau_of};
+
+/// Walls and driving: the three walls are no-slip; the top one moves at `lid_u` (cavity), or the
+/// domain is periodic in x and driven by a body force (channel, lid still).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Boundaries {
+    pub lid_u: f64,
+    pub periodic_x: bool,
+    pub force_x: f64,
+}
+
+impl Boundaries {
+    pub fn cavity(lid_u: f64) -> Boundaries {
+        Boundaries {
+            lid_u,
+            periodic_x: false,
+            force_x: 0.0,
+        }
+    }
+    pub fn channel(force_x: f64) -> Boundaries {
+        Boundaries {
+            lid_u: 0.0,
+            periodic_x: true,
+            force_x,
+        }
+    }
+}
+
+/// The lattice and its fluid.
+#[derive(Debug, Clone)]
+pub struct Solver {
+    pub nx: usize,
+    pub ny: usize,
+    pub fluid: Fluid,
+    pub bounds: Boundaries,
+    pub tau_min: f64,
+    pub tau_max: f64,
+    /// Post-collision populations, direction-major: `f[i·n + y·nx + x]`.
+    f: Vec<f64>,
+    g: Vec<f64>,
+    /// Relaxation time of each cell (from the previous step: the lagged scheme).
+    tau: Vec<f64>,
+    pub steps: u64,
+}
+
+impl Solver {
+    /// A fluid at rest (ρ = 1) on `nx × ny` nodes. τ starts at the value of ν at a unit-ish shear
+    /// rate, clamped.
+    pub fn new(
+        nx: usize,
+        ny: usize,
+        fluid: Fluid,
+        bounds: Boundaries,
+        tau_min: f64,
+        tau_max: f64,
+    ) -> Solver {
+        let n = nx * ny;
+        let mut f = vec![0.0; 9 * n];
+        for i in 0..9 {
+            f[i * n..(i + 1) * n].fill(W[i]);
+        }
+        let tau0 = tau_of(fluid.viscosity(1e-3)).clamp(tau_min, tau_max);
+        Solver {
+            nx,
+            ny,
+            fluid,
+            bounds,
+            tau_min,
+            tau_max,
+            g: f.clone(),
+            f,
+            tau: vec![tau0; n],
+            steps: 0,
+        }
+    }
+
+    fn n(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// One time step over every node.
+    pub fn step(&mut self) {
+        let (nx, ny, n) = (self.nx as isize, self.ny as isize, self.n());
+        let b = self.bounds;
+        let fluid = self.fluid;
+        let (tmin, tmax) = (self.tau_min, self.tau_max);
+        let newtonian_tau = match fluid {
+            Fluid::Newtonian { nu } => Some(tau_of(nu).clamp(tmin, tmax)),
+            _ => None,
+        };
+        let f = &self.f;
+        let g = &mut self.g;
+        let tau = &mut self.tau;
+        for y in 0..ny {
+            let inner_row = y > 0 && y < ny - 1;
+            for x in 0..nx {
+                let cell = (y * nx + x) as usize;
+                let mut fi = [0.0f64; 9];
+                if inner_row && x > 0 && x < nx - 1 {
+                    for i in 0..9 {
+                        let src = cell as isize - (C[i].1 as isize * nx + C[i].0 as isize);
+                        fi[i] = f[i * n + src as usize];
+                    }
+                } else {
+                    for i in 0..9 {
+                        let (mut sx, sy) = (x - C[i].0 as isize, y - C[i].1 as isize);
+                        if b.periodic_x {
+                            sx = sx.rem_euclid(nx);
+                        }
+                        if sx < 0 || sx >= nx || sy < 0 || sy >= ny {
+                            // Half-way bounce-back; the lid adds the momentum of the moving wall.
+                            let mut v = f[OPP[i] * n + cell];
+                            if sy >= ny {
+                                v += 6.0 * W[i] * C[i].0 as f64 * b.lid_u;
+                            }
+                            fi[i] = v;
+                        } else {
+                            fi[i] = f[i * n + (sy * nx + sx) as usize];
+                        }
+                    }
+                }
+                let rho: f64 = fi.iter().sum();
+                let jx = fi[1] - fi[3] + fi[5] - fi[6] - fi[7] + fi[8] + 0.5 * b.force_x;
+                let jy = fi[2] - fi[4] + fi[5] + fi[6] - fi[7] - fi[8];
+                let (ux, uy) = (jx / rho, jy / rho);
+                let mut feq = [0.0f64; 9];
+                for i in 0..9 {
+                    feq[i] = equilibrium(i, rho, ux, uy);
+                }
+                let t = match newtonian_tau {
+                    Some(t) => t,
+                    None => {
+                        // Π^neq = Σ cᵢcᵢ(fᵢ − fᵢᵉᑫ); γ̇ = 3/(2ρτ)·√(2 Π:Π) with last step's τ.
+                        let (mut pxx, mut pyy, mut pxy) = (0.0, 0.0, 0.0);
+                        for i in 1..9 {
+                            let d = fi[i] - feq[i];
+                            let (cx, cy) = (C[i].0 as f64, C[i].1 as f64);
+                            pxx += cx * cx * d;
+                            pyy += cy * cy * d;
+                            pxy += cx * cy * d;
+                        }
+                        let t_old = tau[cell];
+                        let gamma = 1.5 / (rho * t_old)
+                            * (2.0 * (pxx * pxx + pyy * pyy + 2.0 * pxy * pxy)).sqrt();
+                        let t = tau_of(fluid.viscosity(gamma)).clamp(tmin, tmax);
+                        tau[cell] = t;
+                        t
+                    }
+                };
+                let omega = 1.0 / t;
+                if b.force_x != 0.0 {
+                    // Guo: Fᵢ = (1 − ω/2) wᵢ [3(cᵢ − u) + 9(cᵢ·u)cᵢ]·F.
+                    let pre = 1.0 - 0.5 * omega;
+                    for i in 0..9 {
+                        let (cx, cy) = (C[i].0 as f64, C[i].1 as f64);
+                        let cu = cx * ux + cy * uy;
+                        let fx = 3.0 * (cx - ux) + 9.0 * cu * cx;
+                        g[i * n + cell] =
+                            fi[i] - omega * (fi[i] - feq[i]) + pre * W[i] * fx * b.force_x;
+                    }
+                } else {
+                    for i in 0..9 {
+                        g[i * n + cell] = fi[i] - omega * (fi[i] - feq[i]);
+                    }
+                }
+            }
+        }
+        std::mem::swap(&mut self.f, &mut self.g);
+        self.steps += 1;
+    }
+
+    /// Density and velocity of node (x, y), from the post-collision populations (which have the
+    /// same density and momentum as the pre-collision ones, less half the force).
+    pub fn macroscopic(&self, x: usize, y: usize) -> (f64, f64, f64) {
+        let (n, cell) = (self.n(), y * self.nx + x);
+        let fi: Vec<f64> = (0..9).map(|i| self.f[i * n + cell]).collect();
+        let rho: f64 = fi.iter().sum();
+        let jx = fi[1] - fi[3] + fi[5] - fi[6] - fi[7] + fi[8] + 0.5 * self.bounds.force_x;
+        let jy = fi[2] - fi[4] + fi[5] + fi[6] - fi[7] - fi[8];
+        (rho, jx / rho, jy / rho)
+    }
+
+    /// The velocity field, row by row from the bottom: (u, v).
+    pub fn velocity(&self) -> (Vec<f64>, Vec<f64>) {
+        let mut u = Vec::with_capacity(self.n());
+        let mut v = Vec::with_capacity(self.n());
+        for y in 0..self.ny {
+            for x in 0..self.nx {
+                let (_, a, b) = self.macroscopic(x, y);
+                u.push(a);
+                v.push(b);
+            }
+        }
+        (u, v)
+    }
+
+    /// Fraction of cells whose relaxation time sits at a clamp (for non-Newtonian fluids).
+    pub fn clamped_fraction(&self) -> f64 {
+        if self.fluid.is_newtonian() {
+            return 0.0;
+        }
+        let at = self
+            .tau
+            .iter()
+            .filter(|t| **t <= self.tau_min + 1e-12 || **t >= self.tau_max - 1e-12)
+            .count();
+        at as f64 / self.n() as f64
+    }
+
+    /// Runs until the velocity changes by less than `tol` (max over cells, relative to `scale`)
+    /// over `every` steps, or `max_steps`. Returns the steps taken and the last change.
+    pub fn run_to_convergence(
+        &mut self,
+        every: u64,
+        tol: f64,
+        max_steps: u64,
+        scale: f64,
+        mut progress: impl FnMut(u64, f64),
+    ) -> (u64, f64) {
+        let mut last = self.velocity();
+        let mut change = f64::INFINITY;
+        while self.steps < max_steps {
+            for _ in 0..every {
+                self.step();
+            }
+            let now = self.velocity();
+            change = now
+                .0
+                .iter()
+                .zip(&last.0)
+                .chain(now.1.iter().zip(&last.1))
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+                / scale;
+            progress(self.steps, change);
+            last = now;
+            if change < tol {
+                break;
+            }
+        }
+        (self.steps, change)
+    }
+}
