@@ -478,3 +478,84 @@ fn bad_pictures_and_drawings_exit_2_naming_the_file() {
         assert!(!out_path.exists());
     }
 }
+
+#[test]
+fn flow_writes_fields_profiles_and_picture_and_finds_the_vortex() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "cavity",
+        "--re",
+        "100",
+        "--cells",
+        "64",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let summary = text(&out.stdout);
+    // Ghia et al.: the primary vortex of the Re = 100 cavity sits at (0.6172, 0.7344).
+    let line = summary
+        .lines()
+        .find(|l| l.starts_with("vortex centre: x="))
+        .unwrap();
+    let nums: Vec<f64> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    assert!(
+        (nums[0] - 0.6172).abs() < 0.03 && (nums[1] - 0.7344).abs() < 0.03,
+        "{line}"
+    );
+    for f in [
+        "u.csv",
+        "v.csv",
+        "centerline_u.csv",
+        "centerline_v.csv",
+        "speed.png",
+    ] {
+        assert!(dir.path().join(f).exists(), "{f}");
+    }
+    let cu = std::fs::read_to_string(dir.path().join("centerline_u.csv")).unwrap();
+    assert!(cu.starts_with("y,u\n") && cu.lines().count() == 65);
+    let u = std::fs::read_to_string(dir.path().join("u.csv")).unwrap();
+    assert_eq!(u.lines().count(), 65);
+    // The groove in physical units, and its bad inputs.
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "groove",
+        "--material",
+        "newtonian",
+        "--cells",
+        "32",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let s = text(&out.stdout);
+    assert!(
+        s.contains("Reynolds number") && s.contains(" mm, y=") && s.contains("dead zones"),
+        "{s}"
+    );
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "groove",
+        "--material",
+        "porridge",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_bad_input(&out, &["--material porridge", "ceramic-slurry"]);
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "groove",
+        "--rpm=-3",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_bad_input(&out, &["--rpm -3"]);
+}
