@@ -3,6 +3,10 @@
 //! the moving lid by Ladd's rule `fᵢ = f*_ī + 6wᵢρ cᵢ·u_w`; a periodic channel with Guo's body
 //! force; a per-cell relaxation time from the strain rate of the non-equilibrium moments.
 
+// The kernel walks the nine directions indexing several arrays (populations, equilibria, C, W)
+// by the same i: a range loop says that most plainly.
+#![allow(clippy::needless_range_loop)]
+
 use crate::lattice::{C, OPP, W, equilibrium};
 use crate::rheology::{Fluid, tau_of};
 

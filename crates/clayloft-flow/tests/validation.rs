@@ -175,11 +175,11 @@ fn herschel_bulkley_channel_has_the_analytic_plug() {
     let u_plug = exact(0.0);
     let mut worst: f64 = 0.0;
     let mut plug_spread: f64 = 0.0;
-    for j in 0..ny {
+    for (j, uj) in u.iter().enumerate() {
         let y = j as f64 + 0.5 - h;
-        worst = worst.max((u[j] - exact(y)).abs() / u_plug);
+        worst = worst.max((uj - exact(y)).abs() / u_plug);
         if y.abs() < 0.8 * y0 {
-            plug_spread = plug_spread.max((u[j] - u_plug).abs() / u_plug);
+            plug_spread = plug_spread.max((uj - u_plug).abs() / u_plug);
         }
     }
     let show: Vec<String> = (0..ny)
