@@ -4,7 +4,7 @@
 
 use bevy::math::DVec3;
 use bevy::prelude::*;
-use clayloft_model::handles::{HandleRole, handle_frame, handle_position, set_handle};
+use clayloft_model::handles::{HandleRole, nudge_handle};
 use clayloft_model::preview::wall_buffers;
 use clayloft_model::*;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -42,17 +42,7 @@ fn drag_once(app: &mut App, sign: f64) {
 }
 
 fn drag(app: &mut App, role: HandleRole, delta: DVec3) {
-    let world = app.world_mut();
-    let offsets = world
-        .query::<(&ContourRole, &ContourSamples)>()
-        .iter(world)
-        .map(|(r, s)| (*r, s.offset))
-        .collect();
-    let cache = world.resource::<ModelCache>().clone();
-    let mut doc = world.resource_mut::<DesignDoc>();
-    let frame = handle_frame(role, &doc.design, &cache, &offsets).unwrap();
-    let at = handle_position(role, &doc.design, &frame).unwrap();
-    set_handle(role, &mut doc.design, &frame, at + delta);
+    nudge_handle(app.world_mut(), role, delta);
 }
 
 fn rebuild_mesh(app: &mut App) {

@@ -316,6 +316,28 @@ pub fn set_handle(role: HandleRole, design: &mut Design, f: &HandleFrame, target
     *design != before
 }
 
+/// Moves the handle of `role` by `delta` (design space, mm) as a drag would: measured in its
+/// current frame, written into the design document of `world`. Returns false if the handle does
+/// not exist or the value did not change. (Tests, benchmarks and scripted edits use this.)
+pub fn nudge_handle(world: &mut World, role: HandleRole, delta: DVec3) -> bool {
+    let offsets: HashMap<ContourRole, DVec2> = world
+        .query::<(&ContourRole, &ContourSamples)>()
+        .iter(world)
+        .map(|(r, s)| (*r, s.offset))
+        .collect();
+    let cache = world.resource::<ModelCache>().clone();
+    let Some(mut doc) = world.get_resource_mut::<DesignDoc>() else {
+        return false;
+    };
+    let Some(frame) = handle_frame(role, &doc.design, &cache, &offsets) else {
+        return false;
+    };
+    let Some(at) = handle_position(role, &doc.design, &frame) else {
+        return false;
+    };
+    set_handle(role, &mut doc.design, &frame, at + delta)
+}
+
 /// Rounds to 0.001 mm so saved files stay readable.
 fn round3(v: f64) -> f64 {
     (v * 1000.0).round() / 1000.0

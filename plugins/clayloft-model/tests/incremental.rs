@@ -5,7 +5,7 @@ use std::path::Path;
 
 use bevy::prelude::*;
 use clayloft_core::Design;
-use clayloft_model::handles::{HandleRole, handle_frame, handle_position, set_handle};
+use clayloft_model::handles::{HandleRole, nudge_handle};
 use clayloft_model::*;
 
 fn app_with(design: Design) -> App {
@@ -46,17 +46,7 @@ fn assert_matches_pipeline(app: &mut App) {
 
 /// Drags the handle of `role` to where it is plus `delta` (design space, mm).
 fn drag(app: &mut App, role: HandleRole, delta: bevy::math::DVec3) {
-    let world = app.world_mut();
-    let offsets = world
-        .query::<(&ContourRole, &ContourSamples)>()
-        .iter(world)
-        .map(|(r, s)| (*r, s.offset))
-        .collect();
-    let cache = world.resource::<ModelCache>().clone();
-    let mut doc = world.resource_mut::<DesignDoc>();
-    let frame = handle_frame(role, &doc.design, &cache, &offsets).unwrap();
-    let at = handle_position(role, &doc.design, &frame).unwrap();
-    assert!(set_handle(role, &mut doc.design, &frame, at + delta));
+    assert!(nudge_handle(app.world_mut(), role, delta));
 }
 
 #[test]
