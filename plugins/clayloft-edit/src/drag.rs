@@ -262,20 +262,35 @@ fn drag_handle(
     let (Some(state), Some(mut doc)) = (drag.0, doc) else {
         return;
     };
-    let Some((cam, cam_t)) = cams.iter().next() else {
+    let Some((o, d)) = pointer_ray(&cams, ev.pointer_location.position) else {
         return;
     };
-    let Ok(ray) = cam.viewport_to_world(cam_t, ev.pointer_location.position) else {
-        return;
-    };
-    let (o, d) = (ray.origin, *ray.direction);
     let Some(t) = ray_plane(o, d, state.plane_point + state.grab, state.plane_normal) else {
         return;
     };
-    let target = from_world(o + d * t - state.grab);
-    // Write only real changes, so change detection stays quiet while the pointer rests.
+    move_handle_to(&mut doc, state.role, &state.frame, o + d * t - state.grab);
+}
+
+/// The world ray under the pointer: origin and unit direction.
+pub(crate) fn pointer_ray(
+    cams: &Query<(&Camera, &GlobalTransform), With<Camera3d>>,
+    at: Vec2,
+) -> Option<(Vec3, Vec3)> {
+    let (cam, t) = cams.iter().next()?;
+    let ray = cam.viewport_to_world(t, at).ok()?;
+    Some((ray.origin, *ray.direction))
+}
+
+/// Writes the value that puts the handle at `target` (world) into the design — only if it
+/// changes, so change detection stays quiet while the pointer rests.
+pub(crate) fn move_handle_to(
+    doc: &mut DesignDoc,
+    role: HandleRole,
+    frame: &HandleFrame,
+    target: Vec3,
+) {
     let mut edited = doc.design.clone();
-    if set_handle(state.role, &mut edited, &state.frame, target) {
+    if set_handle(role, &mut edited, frame, from_world(target)) {
         doc.design = edited;
     }
 }

@@ -5,11 +5,11 @@
 
 use bevy::picking::Pickable;
 use bevy::prelude::*;
-use clayloft_model::coords::{from_world, to_world};
-use clayloft_model::handles::{HandleFrame, HandleRole, handle_frame, set_handle};
+use clayloft_model::coords::to_world;
+use clayloft_model::handles::{HandleFrame, HandleRole, handle_frame};
 use clayloft_model::*;
 
-use crate::drag::{ActiveDrag, Selection, contour_offsets};
+use crate::drag::{ActiveDrag, Selection, contour_offsets, move_handle_to, pointer_ray};
 use crate::history::EditInProgress;
 use crate::ray::{ray_axis, ray_plane};
 
@@ -130,15 +130,6 @@ fn follow_selection(
     }
 }
 
-fn pointer_ray(
-    cams: &Query<(&Camera, &GlobalTransform), With<Camera3d>>,
-    at: Vec2,
-) -> Option<(Vec3, Vec3)> {
-    let (cam, t) = cams.iter().next()?;
-    let ray = cam.viewport_to_world(t, at).ok()?;
-    Some((ray.origin, *ray.direction))
-}
-
 fn start_gizmo_drag(
     ev: On<Pointer<DragStart>>,
     parts: Query<&GizmoPart>,
@@ -213,10 +204,7 @@ fn gizmo_drag(
             None => return,
         },
     };
-    let mut edited = doc.design.clone();
-    if set_handle(s.role, &mut edited, &s.frame, from_world(target)) {
-        doc.design = edited;
-    }
+    move_handle_to(&mut doc, s.role, &s.frame, target);
 }
 
 fn end_gizmo_drag(

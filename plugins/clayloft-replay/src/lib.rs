@@ -197,16 +197,8 @@ fn spawn_nozzle(
         });
     commands.spawn((
         PrintedPart,
-        Mesh3d(meshes.add(Mesh::from(Cuboid::new(0.0, 0.0, 0.0)))),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            base_color: Color::WHITE,
-            perceptual_roughness: 0.85,
-            double_sided: true,
-            cull_mode: None,
-            ..default()
-        })),
+        clayloft_view::wall_mesh_bundle(&mut meshes, &mut materials),
         Visibility::Hidden,
-        Pickable::IGNORE,
         Name::new("printed part"),
     ));
 }

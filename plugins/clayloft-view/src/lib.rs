@@ -116,15 +116,7 @@ fn spawn_scene(
     // The wall: vertex colours carry the overhang; both faces lit (the inside shows at the rim).
     commands.spawn((
         WallView,
-        Mesh3d(meshes.add(Mesh::from(Cuboid::new(0.0, 0.0, 0.0)))),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            base_color: Color::WHITE,
-            perceptual_roughness: 0.85,
-            double_sided: true,
-            cull_mode: None,
-            ..default()
-        })),
-        Pickable::IGNORE,
+        wall_mesh_bundle(&mut meshes, &mut materials),
         Name::new("wall view"),
     ));
     commands.spawn((
@@ -151,6 +143,25 @@ fn spawn_scene(
         },
         Name::new("toolpath view"),
     ));
+}
+
+/// An empty, unpickable wall mesh whose vertex colours carry the overhang, lit on both faces
+/// (the inside shows at the rim). The replay's printed part uses the same.
+pub fn wall_mesh_bundle(
+    meshes: &mut Assets<Mesh>,
+    materials: &mut Assets<StandardMaterial>,
+) -> impl Bundle {
+    (
+        Mesh3d(meshes.add(Mesh::from(Cuboid::new(0.0, 0.0, 0.0)))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::WHITE,
+            perceptual_roughness: 0.85,
+            double_sided: true,
+            cull_mode: None,
+            ..default()
+        })),
+        Pickable::IGNORE,
+    )
 }
 
 /// Points the camera at the vessel the first time there is one.
