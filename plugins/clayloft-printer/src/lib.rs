@@ -187,7 +187,8 @@ fn draw_printer_window(
     let ctx = contexts.ctx_mut()?.clone();
     egui::Window::new("Printer")
         .default_open(false)
-        .default_pos(egui::pos2(760.0, 640.0))
+        .pivot(egui::Align2::LEFT_BOTTOM)
+        .default_pos(egui::pos2(340.0, 690.0))
         .show(&ctx, |ui| {
             ui.label(egui::RichText::new("Streams the design's G-code line by line (Marlin protocol: numbered lines, checksums, resends). Try it on `clayloft fake-printer`.").small().weak());
             ui.horizontal(|ui| {
