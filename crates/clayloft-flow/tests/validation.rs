@@ -154,11 +154,10 @@ fn power_law_channel_matches_the_analytic_profile() {
     }
 }
 
-/// Open defect: the yielded region matches the analytic Bingham profile to 0.5 %, but the plug
-/// still bulges by about 6 % (as if its viscosity were ~0.4 instead of the regularised ~20);
-/// the lagged-τ strain rate under Guo forcing is the suspect. Run with `--ignored`.
+/// The plug is held by cells at the upper clamp τ_max = 10 (quasi-unyielded). A much larger
+/// τ_max makes it worse, not better: at τ ≈ 50–500 populations travel tens of cells before
+/// relaxing, the stress stops being local, and the plug bulges by 5–6 %.
 #[test]
-#[ignore = "open defect: the plug bulges about 6 %"]
 fn herschel_bulkley_channel_has_the_analytic_plug() {
     let ny = 64;
     let h = ny as f64 / 2.0;
@@ -166,7 +165,7 @@ fn herschel_bulkley_channel_has_the_analytic_plug() {
     let g = 2e-5;
     let y0 = h / 3.0; // plug half-width: τ₀ = G·y₀
     let tau0 = g * y0;
-    let u = channel(Fluid::HerschelBulkley { tau0, k, n, m: 1e5 }, ny, g, 500.0);
+    let u = channel(Fluid::HerschelBulkley { tau0, k, n, m: 1e5 }, ny, g, 10.0);
     // Bingham (n = 1): u = G/(2K)·[(h − y₀)² − (|y| − y₀)²] outside the plug, u(y₀) inside.
     let exact = |y: f64| {
         let yy = y.abs().max(y0);
