@@ -101,9 +101,31 @@ impl Solver {
         let f = &self.f;
         let g = &mut self.g;
         let tau = &mut self.tau;
+        // Newtonian without a body force: interior rows by the vectorisable row kernel.
+        let fast = match newtonian_tau {
+            Some(t) if b.force_x == 0.0 && nx >= 3 && ny >= 3 => Some(1.0 / t),
+            _ => None,
+        };
+        if let Some(omega) = fast {
+            let (nxu, len) = (nx as usize, nx as usize - 2);
+            let mut dirs = g.chunks_mut(n);
+            let mut dst: [&mut [f64]; 9] = std::array::from_fn(|_| dirs.next().unwrap_or_default());
+            for y in 1..ny as usize - 1 {
+                let start = y * nxu + 1;
+                let src: [&[f64]; 9] = std::array::from_fn(|i| {
+                    let from = (start as isize - (C[i].1 as isize * nx + C[i].0 as isize)) as usize;
+                    &f[i * n + from..i * n + from + len]
+                });
+                let mut out: [&mut [f64]; 9] = dst.each_mut().map(|d| &mut d[start..start + len]);
+                bgk_row(&src, &mut out, omega);
+            }
+        }
         for y in 0..ny {
             let inner_row = y > 0 && y < ny - 1;
             for x in 0..nx {
+                if fast.is_some() && inner_row && x > 0 && x < nx - 1 {
+                    continue;
+                }
                 let cell = (y * nx + x) as usize;
                 let mut fi = [0.0f64; 9];
                 if inner_row && x > 0 && x < nx - 1 {
@@ -178,7 +200,39 @@ impl Solver {
         std::mem::swap(&mut self.f, &mut self.g);
         self.steps += 1;
     }
+}
 
+/// BGK collision of one run of interior nodes, written so the compiler can vectorise across x:
+/// straight-line arithmetic on nine source and nine destination slices of equal length.
+#[inline(never)]
+fn bgk_row(src: &[&[f64]; 9], dst: &mut [&mut [f64]; 9], omega: f64) {
+    let len = src[0].len();
+    let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = src.map(|s| &s[..len]);
+    let [d0, d1, d2, d3, d4, d5, d6, d7, d8] = dst.each_mut().map(|d| &mut d[..len]);
+    let (w0, w1, w2) = (4.0 / 9.0, 1.0 / 9.0, 1.0 / 36.0);
+    for x in 0..len {
+        let (f0, f1, f2, f3, f4, f5, f6, f7, f8) = (
+            s0[x], s1[x], s2[x], s3[x], s4[x], s5[x], s6[x], s7[x], s8[x],
+        );
+        let rho = f0 + f1 + f2 + f3 + f4 + f5 + f6 + f7 + f8;
+        let inv = 1.0 / rho;
+        let ux = (f1 - f3 + f5 - f6 - f7 + f8) * inv;
+        let uy = (f2 - f4 + f5 + f6 - f7 - f8) * inv;
+        let usq = 1.5 * (ux * ux + uy * uy);
+        let eq = |w: f64, cu: f64| w * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - usq);
+        d0[x] = f0 - omega * (f0 - eq(w0, 0.0));
+        d1[x] = f1 - omega * (f1 - eq(w1, ux));
+        d2[x] = f2 - omega * (f2 - eq(w1, uy));
+        d3[x] = f3 - omega * (f3 - eq(w1, -ux));
+        d4[x] = f4 - omega * (f4 - eq(w1, -uy));
+        d5[x] = f5 - omega * (f5 - eq(w2, ux + uy));
+        d6[x] = f6 - omega * (f6 - eq(w2, -ux + uy));
+        d7[x] = f7 - omega * (f7 - eq(w2, -ux - uy));
+        d8[x] = f8 - omega * (f8 - eq(w2, ux - uy));
+    }
+}
+
+impl Solver {
     /// Density and velocity of node (x, y), from the post-collision populations (which have the
     /// same density and momentum as the pre-collision ones, less half the force).
     pub fn macroscopic(&self, x: usize, y: usize) -> (f64, f64, f64) {
@@ -249,5 +303,42 @@ impl Solver {
             }
         }
         (self.steps, change)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_kernel_equals_the_general_path() {
+        // A power law with n = 1 is Newtonian but goes through the general per-cell path.
+        let mut fast = Solver::new(
+            17,
+            13,
+            Fluid::Newtonian { nu: 0.05 },
+            Boundaries::cavity(0.1),
+            0.5001,
+            10.0,
+        );
+        let mut general = Solver::new(
+            17,
+            13,
+            Fluid::PowerLaw { k: 0.05, n: 1.0 },
+            Boundaries::cavity(0.1),
+            0.5001,
+            10.0,
+        );
+        for _ in 0..200 {
+            fast.step();
+            general.step();
+        }
+        let worst = fast
+            .f
+            .iter()
+            .zip(&general.f)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-13, "{worst}");
     }
 }
