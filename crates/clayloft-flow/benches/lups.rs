@@ -29,6 +29,14 @@ fn bench(c: &mut Criterion) {
                 }
             })
         });
+        s.threads = 2;
+        g.bench_function(format!("{name}_two_threads"), |b| {
+            b.iter(|| {
+                for _ in 0..10 {
+                    s.step();
+                }
+            })
+        });
     }
     g.finish();
 }

@@ -51,6 +51,8 @@ pub struct Solver {
     /// Relaxation time of each cell (from the previous step: the lagged scheme).
     tau: Vec<f64>,
     pub steps: u64,
+    /// Threads for the Newtonian interior (1 = one core).
+    pub threads: usize,
 }
 
 impl Solver {
@@ -81,6 +83,7 @@ impl Solver {
             f,
             tau: vec![tau0; n],
             steps: 0,
+            threads: 1,
         }
     }
 
@@ -107,17 +110,53 @@ impl Solver {
             _ => None,
         };
         if let Some(omega) = fast {
-            let (nxu, len) = (nx as usize, nx as usize - 2);
-            let mut dirs = g.chunks_mut(n);
-            let mut dst: [&mut [f64]; 9] = std::array::from_fn(|_| dirs.next().unwrap_or_default());
-            for y in 1..ny as usize - 1 {
-                let start = y * nxu + 1;
-                let src: [&[f64]; 9] = std::array::from_fn(|i| {
-                    let from = (start as isize - (C[i].1 as isize * nx + C[i].0 as isize)) as usize;
-                    &f[i * n + from..i * n + from + len]
+            let (nxu, nyu, len) = (nx as usize, ny as usize, nx as usize - 2);
+            // Interior rows 1 .. ny−1, split into `threads` bands; each band gets its own
+            // mutable window of every direction.
+            let bands = self.threads.clamp(1, nyu - 2);
+            let mut windows: Vec<Vec<&mut [f64]>> =
+                (0..bands).map(|_| Vec::with_capacity(9)).collect();
+            let mut starts = vec![1usize];
+            for k in 1..bands {
+                starts.push(1 + (nyu - 2) * k / bands);
+            }
+            starts.push(nyu - 1);
+            for dir in g.chunks_mut(n) {
+                let mut rest = &mut dir[nxu..(nyu - 1) * nxu];
+                for (k, w) in windows.iter_mut().enumerate() {
+                    let (band, tail) = rest.split_at_mut((starts[k + 1] - starts[k]) * nxu);
+                    w.push(band);
+                    rest = tail;
+                }
+            }
+            let run_band = |y0: usize, y1: usize, band: &mut Vec<&mut [f64]>| {
+                for y in y0..y1 {
+                    let start = y * nxu + 1;
+                    let src: [&[f64]; 9] = std::array::from_fn(|i| {
+                        let from =
+                            (start as isize - (C[i].1 as isize * nx + C[i].0 as isize)) as usize;
+                        &f[i * n + from..i * n + from + len]
+                    });
+                    let local = (y - y0) * nxu + 1;
+                    let mut it = band.iter_mut();
+                    let mut out: [&mut [f64]; 9] = std::array::from_fn(|_| {
+                        it.next()
+                            .map(|d| &mut d[local..local + len])
+                            .unwrap_or_default()
+                    });
+                    bgk_row(&src, &mut out, omega);
+                }
+            };
+            if bands == 1 {
+                run_band(starts[0], starts[1], &mut windows[0]);
+            } else {
+                std::thread::scope(|scope| {
+                    for (k, w) in windows.iter_mut().enumerate() {
+                        let (y0, y1) = (starts[k], starts[k + 1]);
+                        let run = &run_band;
+                        scope.spawn(move || run(y0, y1, w));
+                    }
                 });
-                let mut out: [&mut [f64]; 9] = dst.each_mut().map(|d| &mut d[start..start + len]);
-                bgk_row(&src, &mut out, omega);
             }
         }
         for y in 0..ny {
@@ -329,10 +368,14 @@ mod tests {
             0.5001,
             10.0,
         );
+        let mut two = fast.clone();
+        two.threads = 2;
         for _ in 0..200 {
             fast.step();
             general.step();
+            two.step();
         }
+        assert_eq!(fast.f, two.f, "two threads give the same lattice");
         let worst = fast
             .f
             .iter()
