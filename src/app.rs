@@ -40,6 +40,7 @@ pub fn run(design: Design, path: PathBuf, screenshot: Option<ScreenshotRequest>)
         clayloft_replay::ReplayPlugin,
         clayloft_panels::PanelsPlugin,
         clayloft_printer::PrinterPlugin,
+        clayloft_flowview::FlowViewPlugin,
     ));
     let screenshot_mode = screenshot.is_some();
     if let Some(req) = screenshot {

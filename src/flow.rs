@@ -165,31 +165,8 @@ pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
     let (u, v) = solver.velocity();
     let (nx, ny) = (solver.nx, solver.ny);
     write_outputs(&o.out, nx, ny, &u, &v, lid_lu, to_ms)?;
-    // Vortex centre: the extremum of the stream function ψ(x, y) = ∫₀^y u dy' (ψ = 0 on the
-    // walls), i.e. the eye of the recirculation.
-    let mut best = (0.0f64, nx / 2, ny / 2);
-    for x in 0..nx {
-        let mut psi = 0.0;
-        for y in 0..ny {
-            psi += u[y * nx + x];
-            if psi.abs() > best.0.abs() {
-                best = (psi, x, y);
-            }
-        }
-    }
-    let (cx, cy) = (
-        (best.1 as f64 + 0.5) / nx as f64,
-        (best.2 as f64 + 0.5) / ny as f64,
-    );
-    // Dead zones: cells slower than 1 % of the wall in the lower corners (left and right halves).
-    let slow = |x: usize, y: usize| u[y * nx + x].hypot(v[y * nx + x]) < 0.01 * lid_lu;
-    let count = |xs: std::ops::Range<usize>| {
-        (0..ny / 2)
-            .flat_map(|y| xs.clone().map(move |x| (x, y)))
-            .filter(|&(x, y)| slow(x, y))
-            .count()
-    };
-    let (left, right) = (count(0..nx / 2), count(nx / 2..nx));
+    let (cx, cy) = clayloft_flow::analysis::vortex_centre(&u, nx, ny);
+    let (left, right) = clayloft_flow::analysis::dead_cells(&u, &v, nx, ny, 0.01 * lid_lu);
     match cell_mm {
         Some(d) => {
             println!(

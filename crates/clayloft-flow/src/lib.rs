@@ -10,6 +10,7 @@
 //!   channels with a body force (Guo), collision with the shear rate from the non-equilibrium
 //!   moments `γ̇ = 3/(2ρτ)·√(2 Πⁿᵉ:Πⁿᵉ)`.
 
+pub mod analysis;
 pub mod groove;
 pub mod lattice;
 pub mod rheology;
