@@ -196,7 +196,11 @@ fn plot(ui: &mut egui::Ui, label: &str, points: &[(f64, f64)], vertical: bool) {
 fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let view = &mut *view;
-    egui::Window::new("Extruder flow").default_open(false).show(&ctx, |ui| {
+    egui::Window::new("Extruder flow")
+        .default_open(false)
+        .pivot(egui::Align2::LEFT_BOTTOM)
+        .default_pos(egui::pos2(470.0, 690.0))
+        .show(&ctx, |ui| {
         ui.label(egui::RichText::new(
             "The clay inside one turn of the extruder's screw groove, seen in cross-section. The barrel (top) slides over the groove as the screw turns and drags the clay round in a vortex; clay in the lower corners barely moves (dead zones). A yield-stress slurry only flows where it is sheared hard enough.",
         ).small().weak());
