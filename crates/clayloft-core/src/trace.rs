@@ -288,7 +288,11 @@ pub fn trace_grey(img: &GrayImage, threshold: Option<u8>) -> Result<Trace, Trace
     // shoelace area) enclosing the most.
     let mut best: Option<(f64, Vec<DVec2>)> = None;
     let mut seen: std::collections::HashSet<u64> = std::collections::HashSet::new();
-    for &start in next.keys() {
+    // Walk the outlines from their smallest edge key, so a picture always gives the same
+    // outline starting at the same point (HashMap order is random per run).
+    let mut starts: Vec<u64> = next.keys().copied().collect();
+    starts.sort_unstable();
+    for start in starts {
         if seen.contains(&start) {
             continue;
         }
