@@ -177,13 +177,14 @@ fn colour_selected_handle(
     }
 }
 
-/// The camera orbits only when no handle is dragged and the pointer is not over the panels.
+/// The camera orbits only when nothing is dragged and the pointer is not over the panels.
 fn gate_camera(
-    drag: Res<ActiveDrag>,
+    busy: Res<EditInProgress>,
     panel: Res<PanelInUse>,
     mut cams: Query<&mut PanOrbitCamera>,
 ) {
-    let enabled = drag.0.is_none() && !panel.hovered && !panel.editing;
+    // `busy` is set by handle and gizmo drags alike.
+    let enabled = !busy.0 && !panel.hovered && !panel.editing;
     for mut c in &mut cams {
         if c.enabled != enabled {
             c.enabled = enabled;

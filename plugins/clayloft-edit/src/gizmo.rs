@@ -9,7 +9,7 @@ use clayloft_model::coords::to_world;
 use clayloft_model::handles::{HandleFrame, HandleRole, handle_frame};
 use clayloft_model::*;
 
-use crate::drag::{ActiveDrag, Selection, contour_offsets, move_handle_to, pointer_ray};
+use crate::drag::{Selection, contour_offsets, move_handle_to, pointer_ray};
 use crate::history::EditInProgress;
 use crate::ray::{ray_axis, ray_plane};
 
@@ -140,7 +140,6 @@ fn start_gizmo_drag(
     contours: Query<(&ContourRole, &ContourSamples)>,
     cams: Query<(&Camera, &GlobalTransform), With<Camera3d>>,
     mut drag: ResMut<GizmoDrag>,
-    mut handle_drag: ResMut<ActiveDrag>,
     mut busy: ResMut<EditInProgress>,
 ) {
     let (Ok(part), Some(role), Some(doc)) = (parts.get(ev.entity), selection.0, doc) else {
@@ -170,14 +169,6 @@ fn start_gizmo_drag(
         start,
         grab_s,
         grab_point,
-    });
-    // The camera stays still while the gizmo is held (same gate as handle drags).
-    handle_drag.0 = Some(crate::drag::DragState {
-        role,
-        frame,
-        plane_point: start,
-        plane_normal: Vec3::Y,
-        grab: Vec3::ZERO,
     });
     busy.0 = true;
 }
@@ -210,10 +201,8 @@ fn gizmo_drag(
 fn end_gizmo_drag(
     _ev: On<Pointer<DragEnd>>,
     mut drag: ResMut<GizmoDrag>,
-    mut handle_drag: ResMut<ActiveDrag>,
     mut busy: ResMut<EditInProgress>,
 ) {
     drag.0 = None;
-    handle_drag.0 = None;
     busy.0 = false;
 }

@@ -177,7 +177,7 @@ fn role_point(role: HandleRole) -> usize {
 }
 
 /// Index of the sample whose angle is nearest `phi` (radians).
-fn nearest_sample(angles: &[f64], phi: f64) -> Option<usize> {
+pub fn nearest_sample(angles: &[f64], phi: f64) -> Option<usize> {
     (0..angles.len()).min_by(|&a, &b| {
         let da = clayloft_core::control::angle_difference(angles[a], phi).abs();
         let db = clayloft_core::control::angle_difference(angles[b], phi).abs();

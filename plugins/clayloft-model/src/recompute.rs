@@ -261,13 +261,7 @@ fn line_curve(line: ControlLine, design: &Design, model: &ShapeModel) -> Vec<DVe
             };
             let profile = &model.vertical[line.index];
             let phi = v.angle.unwrap_or(0.0).to_radians();
-            let i = (0..n)
-                .min_by(|&a, &b| {
-                    let da = clayloft_core::control::angle_difference(loft.angles[a], phi).abs();
-                    let db = clayloft_core::control::angle_difference(loft.angles[b], phi).abs();
-                    da.total_cmp(&db)
-                })
-                .unwrap_or(0);
+            let i = crate::handles::nearest_sample(&loft.angles, phi).unwrap_or(0);
             (0..=64)
                 .map(|j| {
                     let t = j as f64 / 64.0;
