@@ -11,8 +11,12 @@
 //!   moments `γ̇ = 3/(2ρτ)·√(2 Πⁿᵉ:Πⁿᵉ)`.
 
 pub mod analysis;
+pub mod collision;
+pub mod fastmath;
 pub mod groove;
+pub mod kernel;
 pub mod lattice;
+pub mod parallel;
 pub mod rheology;
 pub mod solver;
 
