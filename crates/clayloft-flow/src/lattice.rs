@@ -26,6 +26,25 @@ pub const W: [f64; 9] = [
 /// The opposite direction of each.
 pub const OPP: [usize; 9] = [0, 3, 4, 1, 2, 7, 8, 5, 6];
 
+/// How populations are kept in memory: single precision, less their rest weight,
+/// `f̃ᵢ = fᵢ − wᵢ` (the "shifted" storage of FluidX3D). At rest f̃ is 0 and it stays of the
+/// order of wᵢ·3cᵢ·u, so single precision resolves it to about 10⁻¹⁰ — as fine as double
+/// precision resolves fᵢ itself near the velocities here — with half the memory traffic: the two
+/// 120 × 120 lattices then fit in a core's L2 cache. All arithmetic is in double precision.
+pub type Stored = f32;
+
+/// The population of direction i from its stored form.
+#[inline(always)]
+pub fn unshift(i: usize, stored: Stored) -> f64 {
+    stored as f64 + W[i]
+}
+
+/// The stored form of population `f` of direction i.
+#[inline(always)]
+pub fn shift(i: usize, f: f64) -> Stored {
+    (f - W[i]) as Stored
+}
+
 /// Equilibrium population i at density ρ and velocity u.
 #[inline(always)]
 pub fn equilibrium(i: usize, rho: f64, ux: f64, uy: f64) -> f64 {

@@ -12,7 +12,7 @@
 //! Herschel–Bulkley channel test).
 
 /// Smallest shear rate used in the viscosity law (lattice units).
-pub const GAMMA_MIN: f64 = 1e-9;
+pub const GAMMA_MIN: f32 = 1e-9;
 
 /// A fluid, in lattice units (kinematic: stresses divided by density).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,7 +26,7 @@ impl Fluid {
     /// Kinematic viscosity at shear rate γ̇.
     #[inline(always)]
     pub fn viscosity(&self, gamma: f64) -> f64 {
-        let g = gamma.max(GAMMA_MIN);
+        let g = gamma.max(GAMMA_MIN as f64);
         match *self {
             Fluid::Newtonian { nu } => nu,
             Fluid::PowerLaw { k, n } => k * g.powf(n - 1.0),

@@ -9,7 +9,7 @@
 
 use crate::collision::{ConstantRate, Relaxation, ShearDependent};
 use crate::kernel::{self, Row};
-use crate::lattice::{C, OPP, W};
+use crate::lattice::{C, OPP, Stored, W, shift, unshift};
 use crate::parallel::{SpinBarrier, band_starts};
 use crate::rheology::{Fluid, tau_of};
 
@@ -48,9 +48,10 @@ pub struct Solver {
     pub bounds: Boundaries,
     pub tau_min: f64,
     pub tau_max: f64,
-    /// Post-collision populations, direction-major: `f[i·n + y·nx + x]`.
-    f: Vec<f64>,
-    g: Vec<f64>,
+    /// Post-collision populations in their stored form ([`Stored`]), direction-major:
+    /// `f[i·n + y·nx + x]`; `g` is the lattice the next step writes.
+    f: Vec<Stored>,
+    g: Vec<Stored>,
     /// Relaxation rate ω = 1/τ of each node after the last step (read by the next: the lagged
     /// scheme), and the buffer the next step writes.
     omega: Vec<f64>,
@@ -72,10 +73,8 @@ impl Solver {
         tau_max: f64,
     ) -> Solver {
         let n = nx * ny;
-        let mut f = vec![0.0; 9 * n];
-        for i in 0..9 {
-            f[i * n..(i + 1) * n].fill(W[i]);
-        }
+        // At rest with ρ = 1 every population equals its weight: stored as 0.
+        let f = vec![0.0; 9 * n];
         let tau0 = tau_of(fluid.viscosity(1e-3)).clamp(tau_min, tau_max);
         Solver {
             nx,
@@ -182,11 +181,11 @@ impl Solver {
 
 /// The nine directions of the source lattice (whole) and of the destination rows `rows`.
 fn split_directions<'a>(
-    src: &'a [f64],
-    dst: &'a mut [f64],
+    src: &'a [Stored],
+    dst: &'a mut [Stored],
     rows: std::ops::Range<usize>,
     nx: usize,
-) -> ([&'a [f64]; 9], [&'a mut [f64]; 9]) {
+) -> ([&'a [Stored]; 9], [&'a mut [Stored]; 9]) {
     let n = src.len() / 9;
     let mut dirs = dst.chunks_mut(n);
     (
@@ -219,8 +218,8 @@ impl Frame {
     /// step, so doing one twice is harmless).
     fn update_rows<R: Relaxation, const FORCED: bool>(
         &self,
-        src: [&[f64]; 9],
-        mut dst: [&mut [f64]; 9],
+        src: [&[Stored]; 9],
+        mut dst: [&mut [Stored]; 9],
         (omega_old, omega_new): (&[f64], &mut [f64]),
         rows: std::ops::Range<usize>,
         relax: &R,
@@ -231,7 +230,7 @@ impl Frame {
             let start = first * nx + 1;
             let len = (last - 1) * nx + nx - 1 - start;
             let local = start - rows.start * nx;
-            let pulled: [&[f64]; 9] = std::array::from_fn(|i| {
+            let pulled: [&[Stored]; 9] = std::array::from_fn(|i| {
                 let from = start as isize - (C[i].1 as isize * nx as isize + C[i].0 as isize);
                 &src[i][from as usize..from as usize + len]
             });
@@ -259,14 +258,14 @@ impl Frame {
             }
         }
         let m = nodes.len();
-        let mut scratch = vec![0.0; 20 * m];
-        let (pulled, rest) = scratch.split_at_mut(9 * m);
-        let (out, rates) = rest.split_at_mut(9 * m);
+        let mut populations: Vec<Stored> = vec![0.0; 18 * m];
+        let (pulled, out) = populations.split_at_mut(9 * m);
+        let mut rates = vec![0.0; 2 * m];
         let (w_old, w_new) = rates.split_at_mut(m);
         for (k, &(x, y)) in nodes.iter().enumerate() {
             let f = self.pull_at_wall(&src, x, y);
             for i in 0..9 {
-                pulled[i * m + k] = f[i];
+                pulled[i * m + k] = shift(i, f[i]);
             }
             w_old[k] = omega_old[(y - rows.start) * nx + x];
         }
@@ -291,7 +290,7 @@ impl Frame {
     /// would come from outside bounce back half-way, `fᵢ = f*_ī`, and the lid adds the momentum
     /// of the moving wall, `6wᵢρ cᵢ·u_w` with ρ ≈ 1.
     #[inline(always)]
-    fn pull_at_wall(&self, src: &[&[f64]; 9], x: usize, y: usize) -> [f64; 9] {
+    fn pull_at_wall(&self, src: &[&[Stored]; 9], x: usize, y: usize) -> [f64; 9] {
         let (nx, ny) = (self.nx as isize, self.ny as isize);
         let b = self.bounds;
         let cell = y * self.nx + x;
@@ -303,13 +302,13 @@ impl Frame {
                 sx = sx.rem_euclid(nx);
             }
             f[i] = if sx < 0 || sx >= nx || sy < 0 || sy >= ny {
-                let mut v = src[OPP[i]][cell];
+                let mut v = unshift(OPP[i], src[OPP[i]][cell]);
                 if sy >= ny {
                     v += 6.0 * W[i] * C[i].0 as f64 * b.lid_u;
                 }
                 v
             } else {
-                src[i][(sy * nx + sx) as usize]
+                unshift(i, src[i][(sy * nx + sx) as usize])
             };
         }
         f
@@ -324,7 +323,7 @@ impl Frame {
 /// before the next step's reads. The pointers come from `&mut` borrows of the solver's vectors
 /// that outlive the threads.
 struct SharedLattices {
-    f: [*mut f64; 2],
+    f: [*mut Stored; 2],
     omega: [*mut f64; 2],
     n: usize,
     nx: usize,
@@ -336,8 +335,8 @@ unsafe impl Sync for SharedLattices {}
 /// A band's view of the lattices in one step: source directions, destination rows, and its rows
 /// of the old and new ω.
 type BandView<'a> = (
-    [&'a [f64]; 9],
-    [&'a mut [f64]; 9],
+    [&'a [Stored]; 9],
+    [&'a mut [Stored]; 9],
     (&'a [f64], &'a mut [f64]),
 );
 
@@ -371,7 +370,7 @@ impl Solver {
     /// same density and momentum as the pre-collision ones, less half the force).
     pub fn macroscopic(&self, x: usize, y: usize) -> (f64, f64, f64) {
         let (n, cell) = (self.n(), y * self.nx + x);
-        let fi: Vec<f64> = (0..9).map(|i| self.f[i * n + cell]).collect();
+        let fi: Vec<f64> = (0..9).map(|i| unshift(i, self.f[i * n + cell])).collect();
         let rho: f64 = fi.iter().sum();
         let jx = fi[1] - fi[3] + fi[5] - fi[6] - fi[7] + fi[8] + 0.5 * self.bounds.force_x;
         let jy = fi[2] - fi[4] + fi[5] + fi[6] - fi[7] - fi[8];
@@ -456,7 +455,7 @@ mod tests {
             ny: s.ny,
             bounds: s.bounds,
         };
-        let src: [&[f64]; 9] = std::array::from_fn(|i| &s.f[i * n..(i + 1) * n]);
+        let src: [&[Stored]; 9] = std::array::from_fn(|i| &s.f[i * n..(i + 1) * n]);
         let mut g = vec![0.0; 9 * n];
         let mut omega = vec![0.0; n];
         for y in 0..s.ny {
@@ -470,7 +469,7 @@ mod tests {
                     collide::<_, false>(&mut f, &law, s.omega[cell], 0.0)
                 };
                 for i in 0..9 {
-                    g[i * n + cell] = f[i];
+                    g[i * n + cell] = shift(i, f[i]);
                 }
             }
         }
@@ -484,15 +483,15 @@ mod tests {
 
     impl Relaxation for ReferenceLaw {
         const PER_NODE: bool = true;
-        fn omega_at(&self, gamma: f64) -> f64 {
-            1.0 / tau_of(self.0.viscosity(gamma)).clamp(self.1, self.2)
+        fn omega_at(&self, gamma_sq: f64) -> f64 {
+            1.0 / tau_of(self.0.viscosity(gamma_sq.sqrt())).clamp(self.1, self.2)
         }
     }
 
-    fn worst_difference(a: &[f64], b: &[f64]) -> f64 {
+    fn worst_difference<T: Copy + Into<f64>>(a: &[T], b: &[T]) -> f64 {
         a.iter()
             .zip(b)
-            .map(|(a, b)| (a - b).abs())
+            .map(|(a, b)| ((*a).into() - (*b).into()).abs())
             .fold(0.0, f64::max)
     }
 
@@ -532,13 +531,15 @@ mod tests {
                 "{fluid:?}: and the same relaxation rates"
             );
             let worst = worst_difference(&fast.f, &plain.f);
+            // Single-precision storage: the two orders of arithmetic may round a population to
+            // neighbouring floats (7·10⁻⁹ apart near 0.06); a real fault shows as 10⁻⁵ and more.
             assert!(
-                worst < 1e-12,
+                worst < 1e-7,
                 "{fluid:?} {bounds:?}: populations differ by {worst}"
             );
             if !fluid.is_newtonian() {
                 let worst = worst_difference(&fast.omega, &plain.omega);
-                assert!(worst < 1e-11, "{fluid:?}: ω differs by {worst}");
+                assert!(worst < 1e-5, "{fluid:?}: ω differs by {worst}");
             }
             // Something happened: the lid or the force moved the fluid.
             let (u, _) = fast.velocity();
@@ -593,12 +594,7 @@ mod tests {
             two.step();
         }
         assert_eq!(fast.f, two.f, "two threads give the same lattice");
-        let worst = fast
-            .f
-            .iter()
-            .zip(&general.f)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-13, "{worst}");
+        let worst = worst_difference(&fast.f, &general.f);
+        assert!(worst < 1e-7, "{worst}");
     }
 }
