@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use clayloft_flow::analysis;
 use clayloft_flow::groove::{Groove, MATERIALS, Material, material};
 use clayloft_flow::{Boundaries, Fluid, Solver};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -24,8 +25,30 @@ pub struct FlowOptions {
     pub yield_stress: Option<f64>,
     pub consistency: Option<f64>,
     pub flow_index: Option<f64>,
+    pub pressure_gradient: f64,
     pub max_steps: u64,
+    pub threads: usize,
     pub out: PathBuf,
+}
+
+/// What a case sets up: the solver, the velocity scale in lattice units (the lid, the wall, or
+/// the channel's centre speed), millimetres per cell (None: normalised), and the factor from
+/// lattice velocity to m/s.
+struct Setup {
+    solver: Solver,
+    scale_lu: f64,
+    cell_mm: Option<f64>,
+    to_ms: f64,
+    /// For the channel: the analytic profile in lattice units, and the plug half-width in mm.
+    channel: Option<Channel>,
+}
+
+struct Channel {
+    exact: Vec<f64>,
+    /// The yield stress in lattice units, and the analytic plug half-width in mm.
+    tau0_lu: f64,
+    plug_half_mm: f64,
+    gap_mm: f64,
 }
 
 pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
@@ -35,100 +58,26 @@ pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
             o.cells
         )));
     }
+    if !(1..=64).contains(&o.threads) {
+        return Err(Failure(format!(
+            "--threads {}: must lie in 1 … 64",
+            o.threads
+        )));
+    }
+    let mut setup = match o.case.as_str() {
+        "cavity" => cavity(&o)?,
+        "groove" => groove(&o, material_of(&o)?)?,
+        "channel" => channel(&o, material_of(&o)?)?,
+        other => {
+            return Err(Failure(format!(
+                "--case {other}: choose cavity, groove or channel"
+            )));
+        }
+    };
     std::fs::create_dir_all(&o.out)
         .map_err(|e| Failure(format!("{}: cannot create: {e}", o.out.display())))?;
-    // (solver, lid speed in lattice units, metres per cell or None for normalised, scale to m/s)
-    let (mut solver, lid_lu, cell_mm, to_ms, title) = match o.case.as_str() {
-        "cavity" => {
-            if !(0.01..=5000.0).contains(&o.re) {
-                return Err(Failure(format!("--re {}: must lie in 0.01 … 5000", o.re)));
-            }
-            let lid = 0.1;
-            let nu = lid * o.cells as f64 / o.re;
-            let s = Solver::new(
-                o.cells,
-                o.cells,
-                Fluid::Newtonian { nu },
-                Boundaries::cavity(lid),
-                0.5001,
-                1000.0,
-            );
-            println!(
-                "lid-driven cavity, Re = {}, {} × {} lattice, τ = {:.3}",
-                o.re,
-                o.cells,
-                o.cells,
-                3.0 * nu + 0.5
-            );
-            (s, lid, None, 1.0 / lid, "cavity".to_string())
-        }
-        "groove" => {
-            let mut m: Material = material(&o.material).ok_or_else(|| {
-                let names: Vec<&str> = MATERIALS.iter().map(|m| m.name).collect();
-                Failure(format!(
-                    "--material {}: unknown (choose {})",
-                    o.material,
-                    names.join(", ")
-                ))
-            })?;
-            if let Some(t) = o.yield_stress {
-                m.tau0 = t;
-            }
-            if let Some(k) = o.consistency {
-                m.k = k;
-            }
-            if let Some(n) = o.flow_index {
-                m.n = n;
-            }
-            for (name, v, lo, hi) in [
-                ("--rpm", o.rpm, 0.1, 1000.0),
-                ("--diameter", o.diameter_mm, 1.0, 500.0),
-                ("--width", o.width_mm, 0.1, 100.0),
-                ("--depth", o.depth_mm, 0.1, 100.0),
-                ("--yield-stress", m.tau0, 0.0, 1e5),
-                ("--consistency", m.k, 1e-3, 1e6),
-                ("--flow-index", m.n, 0.1, 2.0),
-            ] {
-                if !(v.is_finite() && (lo..=hi).contains(&v)) {
-                    return Err(Failure(format!("{name} {v}: must lie in {lo} … {hi}")));
-                }
-            }
-            let g = Groove {
-                width_m: o.width_mm * 1e-3,
-                depth_m: o.depth_mm * 1e-3,
-                screw_diameter_m: o.diameter_mm * 1e-3,
-                rpm: o.rpm,
-                material: m,
-            };
-            let l = g.to_lattice(o.cells, 1.0);
-            println!(
-                "groove {} × {} mm, screw Ø {} mm at {} rpm: barrel wall {:.4} m/s",
-                o.width_mm, o.depth_mm, o.diameter_mm, o.rpm, l.lid_speed
-            );
-            println!(
-                "material {} (τ₀ = {} Pa, K = {} Pa·sⁿ, n = {}, ρ = {} kg/m³): {}",
-                m.name, m.tau0, m.k, m.n, m.rho, m.source
-            );
-            println!(
-                "Reynolds number Re = U·H/ν(U/H) = {:.3e} (Stokes flow); lattice {} × {}, Δx = {:.1} µm, Δt = {:.3e} s, wall {:.3e} lattice units",
-                l.reynolds,
-                l.nx,
-                l.ny,
-                l.dx * 1e6,
-                l.dt,
-                l.lid_u
-            );
-            let s = Solver::new(l.nx, l.ny, l.fluid, Boundaries::cavity(l.lid_u), 0.51, 10.0);
-            (
-                s,
-                l.lid_u,
-                Some(l.dx * 1e3),
-                l.dx / l.dt,
-                "groove".to_string(),
-            )
-        }
-        other => return Err(Failure(format!("--case {other}: choose cavity or groove"))),
-    };
+    let solver = &mut setup.solver;
+    solver.threads = o.threads;
     let bar = ProgressBar::new(o.max_steps);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} steps {msg}")
@@ -141,33 +90,43 @@ pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
         _ => 1.0 / 6.0,
     };
     let min_steps = ((2.0 * (solver.ny * solver.ny) as f64 / nu_ref) as u64).min(o.max_steps);
-    for k in 0..min_steps {
-        solver.step();
-        if k % 1000 == 0 {
-            bar.set_position(k);
-        }
+    while solver.steps < min_steps {
+        solver.advance(1000.min(min_steps - solver.steps));
+        bar.set_position(solver.steps);
     }
-    let (steps, change) = solver.run_to_convergence(1000, 1e-6, o.max_steps, lid_lu, |s, c| {
-        bar.set_position(s);
-        bar.set_message(format!("change {c:.1e}"));
-    });
+    let started = std::time::Instant::now();
+    let steps_before = solver.steps;
+    let (steps, change) =
+        solver.run_to_convergence(1000, 1e-6, o.max_steps, setup.scale_lu, |s, c| {
+            bar.set_position(s);
+            bar.set_message(format!("change {c:.1e}"));
+        });
     bar.finish_and_clear();
     let converged = change < 1e-6;
+    let lups = ((steps - steps_before) * (solver.nx * solver.ny) as u64) as f64
+        / started.elapsed().as_secs_f64().max(1e-9);
     println!(
-        "{} after {steps} steps (velocity change {change:.1e} of the wall speed per 1000 steps); {:.1} % of cells at the relaxation-time clamp",
+        "{} after {steps} steps (velocity change {change:.1e} of the velocity scale per 1000 steps); {:.1} % of cells at the relaxation-time clamp; {:.0} million lattice updates/s on {} thread(s)",
         if converged {
             "converged"
         } else {
             "stopped unconverged"
         },
-        solver.clamped_fraction() * 100.0
+        solver.clamped_fraction() * 100.0,
+        lups / 1e6,
+        o.threads,
     );
     let (u, v) = solver.velocity();
     let (nx, ny) = (solver.nx, solver.ny);
-    write_outputs(&o.out, nx, ny, &u, &v, lid_lu, to_ms)?;
-    let (cx, cy) = clayloft_flow::analysis::vortex_centre(&u, nx, ny);
-    let (left, right) = clayloft_flow::analysis::dead_cells(&u, &v, nx, ny, 0.01 * lid_lu);
-    match cell_mm {
+    write_outputs(&o.out, nx, ny, &u, &v, setup.scale_lu, setup.to_ms)?;
+    if let Some(c) = &setup.channel {
+        report_channel(solver, c, &u, setup.to_ms);
+        println!("wrote channel results to {}", o.out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let (cx, cy) = analysis::vortex_centre(&u, nx, ny);
+    let (left, right) = analysis::dead_cells(&u, &v, nx, ny, 0.01 * setup.scale_lu);
+    match setup.cell_mm {
         Some(d) => {
             println!(
                 "vortex centre: x={:.2} mm, y={:.2} mm",
@@ -189,8 +148,221 @@ pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
             );
         }
     }
-    println!("wrote {title} results to {}", o.out.display());
+    println!("wrote {} results to {}", o.case, o.out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// The lid-driven cavity at `--re`, normalised (the Ghia et al. benchmark).
+fn cavity(o: &FlowOptions) -> Result<Setup, Failure> {
+    if !(0.01..=5000.0).contains(&o.re) {
+        return Err(Failure(format!("--re {}: must lie in 0.01 … 5000", o.re)));
+    }
+    let lid = 0.1;
+    let nu = lid * o.cells as f64 / o.re;
+    let solver = Solver::new(
+        o.cells,
+        o.cells,
+        Fluid::Newtonian { nu },
+        Boundaries::cavity(lid),
+        0.5001,
+        1000.0,
+    );
+    println!(
+        "lid-driven cavity, Re = {}, {} × {} lattice, τ = {:.3}",
+        o.re,
+        o.cells,
+        o.cells,
+        3.0 * nu + 0.5
+    );
+    Ok(Setup {
+        solver,
+        scale_lu: lid,
+        cell_mm: None,
+        to_ms: 1.0 / lid,
+        channel: None,
+    })
+}
+
+/// The material preset with the user's overrides, checked.
+fn material_of(o: &FlowOptions) -> Result<Material, Failure> {
+    let mut m: Material = material(&o.material).ok_or_else(|| {
+        let names: Vec<&str> = MATERIALS.iter().map(|m| m.name).collect();
+        Failure(format!(
+            "--material {}: unknown (choose {})",
+            o.material,
+            names.join(", ")
+        ))
+    })?;
+    if let Some(t) = o.yield_stress {
+        m.tau0 = t;
+    }
+    if let Some(k) = o.consistency {
+        m.k = k;
+    }
+    if let Some(n) = o.flow_index {
+        m.n = n;
+    }
+    for (name, v, lo, hi) in [
+        ("--rpm", o.rpm, 0.1, 1000.0),
+        ("--diameter", o.diameter_mm, 1.0, 500.0),
+        ("--width", o.width_mm, 0.1, 100.0),
+        ("--depth", o.depth_mm, 0.1, 100.0),
+        ("--pressure-gradient", o.pressure_gradient, 1e-3, 1e4),
+        ("--yield-stress", m.tau0, 0.0, 1e5),
+        ("--consistency", m.k, 1e-3, 1e6),
+        ("--flow-index", m.n, 0.1, 2.0),
+    ] {
+        if !(v.is_finite() && (lo..=hi).contains(&v)) {
+            return Err(Failure(format!("{name} {v}: must lie in {lo} … {hi}")));
+        }
+    }
+    println!(
+        "material {} (τ₀ = {} Pa, K = {} Pa·sⁿ, n = {}, ρ = {} kg/m³): {}",
+        m.name, m.tau0, m.k, m.n, m.rho, m.source
+    );
+    Ok(m)
+}
+
+/// The screw groove in physical units, converted through the Reynolds number.
+fn groove(o: &FlowOptions, m: Material) -> Result<Setup, Failure> {
+    let g = Groove {
+        width_m: o.width_mm * 1e-3,
+        depth_m: o.depth_mm * 1e-3,
+        screw_diameter_m: o.diameter_mm * 1e-3,
+        rpm: o.rpm,
+        material: m,
+    };
+    let l = g.to_lattice(o.cells, 1.0);
+    println!(
+        "groove {} × {} mm, screw Ø {} mm at {} rpm: barrel wall {:.4} m/s",
+        o.width_mm, o.depth_mm, o.diameter_mm, o.rpm, l.lid_speed
+    );
+    println!(
+        "Reynolds number Re = U·H/ν(U/H) = {:.3e} (Stokes flow); lattice {} × {}, Δx = {:.1} µm, Δt = {:.3e} s, wall {:.3e} lattice units",
+        l.reynolds,
+        l.nx,
+        l.ny,
+        l.dx * 1e6,
+        l.dt,
+        l.lid_u
+    );
+    Ok(Setup {
+        solver: Solver::new(l.nx, l.ny, l.fluid, Boundaries::cavity(l.lid_u), 0.51, 10.0),
+        scale_lu: l.lid_u,
+        cell_mm: Some(l.dx * 1e3),
+        to_ms: l.dx / l.dt,
+        channel: None,
+    })
+}
+
+/// Clay pushed by pressure through a slot `--depth` wide (the flow along the barrel and into
+/// the nozzle). Without inertia the profile depends only on the flow index n and on how far the
+/// yield zone reaches, y₀/h = τ₀/(G·h); the lattice reproduces those two numbers with a centre
+/// speed of 0.02 and a wall viscosity of 0.1, and the analytic centre speed in m/s scales it back.
+fn channel(o: &FlowOptions, m: Material) -> Result<Setup, Failure> {
+    let g_phys = o.pressure_gradient * 1e6; // MPa/m → Pa/m
+    let h_phys = o.depth_mm * 1e-3 / 2.0;
+    let y0_phys = m.tau0 / g_phys;
+    println!(
+        "channel {} mm wide, pressure gradient {} MPa/m: wall stress G·h = {:.0} Pa",
+        o.depth_mm,
+        o.pressure_gradient,
+        g_phys * h_phys
+    );
+    if y0_phys >= h_phys {
+        return Err(Failure(format!(
+            "--pressure-gradient {}: the slurry does not yield (its yield stress {} Pa needs more than {:.3} MPa/m across {} mm)",
+            o.pressure_gradient,
+            m.tau0,
+            m.tau0 / h_phys / 1e6,
+            o.depth_mm
+        )));
+    }
+    let beta = y0_phys / h_phys;
+    let (n, ny, nx) = (m.n, o.cells, 4);
+    let h = ny as f64 / 2.0;
+    let a = (n + 1.0) / n;
+    let u_max = 0.02;
+    // u_max = n/(n+1)·(G/K)^(1/n)·(h(1−β))^a, and ν at the wall = G·h/γ̇_w = 0.1.
+    let g_over_k = (u_max * (n + 1.0) / n / (h * (1.0 - beta)).powf(a)).powf(n);
+    let gamma_wall = (g_over_k * h * (1.0 - beta)).powf(1.0 / n);
+    let g = 0.1 * gamma_wall / h;
+    let k = g / g_over_k;
+    let tau0 = g * beta * h;
+    let fluid = if tau0 > 0.0 {
+        Fluid::HerschelBulkley {
+            tau0,
+            k,
+            n,
+            m: 50.0 * h / u_max,
+        }
+    } else if n == 1.0 {
+        Fluid::Newtonian { nu: k }
+    } else {
+        Fluid::PowerLaw { k, n }
+    };
+    let exact: Vec<f64> = (0..ny)
+        .map(|j| analysis::plane_poiseuille(tau0, k, n, g, h, j as f64 + 0.5 - h))
+        .collect();
+    let u_phys =
+        analysis::plane_poiseuille(m.tau0 / m.rho, m.k / m.rho, n, g_phys / m.rho, h_phys, 0.0);
+    let nu_wall =
+        g_phys * h_phys / m.rho / ((g_phys * h_phys - m.tau0) / m.k).max(1e-30).powf(1.0 / n);
+    println!(
+        "centre speed {:.4} m/s, Reynolds number ρ·U·h/η_wall = {:.3e} (parallel flow: inertia plays no part); plug half-width y₀ = τ₀/G = {:.3} mm of {:.3} mm; lattice {nx} × {ny} (periodic along the channel)",
+        u_phys,
+        u_phys * h_phys / nu_wall,
+        y0_phys * 1e3,
+        h_phys * 1e3
+    );
+    Ok(Setup {
+        solver: Solver::new(nx, ny, fluid, Boundaries::channel(g), 0.505, 10.0),
+        scale_lu: u_max,
+        cell_mm: Some(o.depth_mm / ny as f64),
+        to_ms: u_phys / u_max,
+        channel: Some(Channel {
+            exact,
+            tau0_lu: tau0,
+            plug_half_mm: y0_phys * 1e3,
+            gap_mm: o.depth_mm,
+        }),
+    })
+}
+
+/// The channel's profile against the analytic one, the plug, and the flow rate.
+fn report_channel(solver: &Solver, c: &Channel, u: &[f64], to_ms: f64) {
+    let (nx, ny) = (solver.nx, solver.ny);
+    let column: Vec<f64> = (0..ny).map(|y| u[y * nx + nx / 2]).collect();
+    let peak = c.exact.iter().cloned().fold(0.0, f64::max);
+    let worst = column
+        .iter()
+        .zip(&c.exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let (_, at_limit) = solver.clamped_fractions();
+    let cell_mm = c.gap_mm / ny as f64;
+    // The plug: rows of the middle column whose shear stress stays below the yield stress.
+    let stress = solver.shear_stresses();
+    let plug_rows = (0..ny)
+        .filter(|&y| stress[y * nx + nx / 2] < c.tau0_lu)
+        .count();
+    let flow: f64 = column.iter().sum::<f64>() * to_ms * cell_mm; // m/s · mm = mm·m/s
+    println!(
+        "profile within {:.1} % of the analytic Herschel–Bulkley profile (of the centre speed)",
+        100.0 * worst / peak
+    );
+    if c.tau0_lu > 0.0 {
+        println!(
+            "plug (stress below the yield stress): half-width {:.3} mm; analytic y₀ = τ₀/G = {:.3} mm",
+            plug_rows as f64 * cell_mm / 2.0,
+            c.plug_half_mm
+        );
+    }
+    println!(
+        "{:.0} % of the gap at the viscosity limit (barely sheared: the plug, and for n < 1 its edges)",
+        at_limit * 100.0
+    );
+    println!("flow rate {:.1} mm³/s per mm of channel width", flow * 1e3);
 }
 
 fn write_csv(path: &Path, text: String) -> Result<(), Failure> {
@@ -237,70 +409,43 @@ fn write_outputs(
     speed_png(&dir.join("speed.png"), nx, ny, u, v, lid)
 }
 
-/// Speed (dark blue → yellow) with white streamlines traced from a grid of seeds (RK2 on the
-/// bilinear velocity field).
+/// Speed (dark blue → yellow) with white streamlines ([`analysis::streamlines`]). A periodic
+/// channel only a few cells long is repeated along its length so the picture is not a sliver.
 fn speed_png(
     path: &Path,
     nx: usize,
     ny: usize,
     u: &[f64],
     v: &[f64],
-    lid: f64,
+    scale: f64,
 ) -> Result<(), Failure> {
+    let (nx, u, v) = if nx * 4 < ny {
+        let wide = ny / 2;
+        let tile = |f: &[f64]| -> Vec<f64> {
+            (0..ny)
+                .flat_map(|y| (0..wide).map(move |x| (x, y)))
+                .map(|(x, y)| f[y * nx + x % nx])
+                .collect()
+        };
+        (wide, tile(u), tile(v))
+    } else {
+        (nx, u.to_vec(), v.to_vec())
+    };
     let px = (480 / nx.max(ny)).max(1);
     let (w, h) = ((nx * px) as u32, (ny * px) as u32);
-    let at = |fx: f64, fy: f64, f: &[f64]| {
-        let (x0, y0) = (
-            (fx - 0.5).clamp(0.0, nx as f64 - 1.001),
-            (fy - 0.5).clamp(0.0, ny as f64 - 1.001),
-        );
-        let (i, j) = (x0 as usize, y0 as usize);
-        let (a, b) = (x0 - i as f64, y0 - j as f64);
-        let g = |x: usize, y: usize| f[y.min(ny - 1) * nx + x.min(nx - 1)];
-        g(i, j) * (1.0 - a) * (1.0 - b)
-            + g(i + 1, j) * a * (1.0 - b)
-            + g(i, j + 1) * (1.0 - a) * b
-            + g(i + 1, j + 1) * a * b
-    };
     let mut img = image::RgbImage::from_fn(w, h, |x, y| {
         let (fx, fy) = (
             (x as f64 + 0.5) / px as f64,
             ny as f64 - (y as f64 + 0.5) / px as f64,
         );
-        let s = (at(fx, fy, u).hypot(at(fx, fy, v)) / lid)
-            .clamp(0.0, 1.0)
-            .powf(0.5);
-        image::Rgb([
-            (255.0 * s) as u8,
-            (40.0 + 180.0 * s) as u8,
-            (120.0 * (1.0 - s) + 40.0) as u8,
-        ])
+        let (a, b) = analysis::velocity_at(&u, &v, nx, ny, fx, fy);
+        image::Rgb(analysis::speed_colour(a.hypot(b) / scale))
     });
-    let seeds = 8;
-    for sy in 0..seeds {
-        for sx in 0..seeds {
-            let (mut x, mut y) = (
-                (sx as f64 + 0.5) * nx as f64 / seeds as f64,
-                (sy as f64 + 0.5) * ny as f64 / seeds as f64,
-            );
-            for _ in 0..400 {
-                let (a, b) = (at(x, y, u), at(x, y, v));
-                let sp = a.hypot(b);
-                if sp < 1e-6 * lid {
-                    break;
-                }
-                let step = 0.4 / sp;
-                let (mx, my) = (x + 0.5 * step * a, y + 0.5 * step * b);
-                let (a2, b2) = (at(mx, my, u), at(mx, my, v));
-                x += step * a2;
-                y += step * b2;
-                if x < 0.0 || y < 0.0 || x >= nx as f64 || y >= ny as f64 {
-                    break;
-                }
-                let (ix, iy) = ((x * px as f64) as u32, ((ny as f64 - y) * px as f64) as u32);
-                if ix < w && iy < h {
-                    img.put_pixel(ix, iy, image::Rgb([245, 245, 245]));
-                }
+    for line in analysis::streamlines(&u, &v, nx, ny, 8, 1e-6 * scale) {
+        for (x, y) in line {
+            let (ix, iy) = ((x * px as f64) as u32, ((ny as f64 - y) * px as f64) as u32);
+            if ix < w && iy < h {
+                img.put_pixel(ix, iy, image::Rgb([245, 245, 245]));
             }
         }
     }

@@ -97,7 +97,8 @@ enum Command {
     },
     /// Simulate the clay in the extruder's screw groove (lattice Boltzmann) and write CSV + PNG.
     Flow {
-        /// cavity (Ghia benchmark, normalised) or groove (physical units).
+        /// cavity (Ghia benchmark, normalised), groove (the screw groove, physical units) or
+        /// channel (pushed through a slot by pressure: the plug of a yield-stress slurry).
         #[arg(long, default_value = "groove")]
         case: String,
         /// Lattice cells across the width.
@@ -111,11 +112,14 @@ enum Command {
         /// Screw diameter, mm.
         #[arg(long, default_value_t = 20.0)]
         diameter: f64,
-        /// Groove width and depth, mm.
+        /// Groove width and depth, mm (the channel's gap is the depth).
         #[arg(long, default_value_t = 4.0)]
         width: f64,
         #[arg(long, default_value_t = 4.0)]
         depth: f64,
+        /// Pressure gradient along the channel, MPa/m.
+        #[arg(long, default_value_t = 0.5)]
+        pressure_gradient: f64,
         /// newtonian, clay-paste or ceramic-slurry.
         #[arg(long, default_value = "ceramic-slurry")]
         material: String,
@@ -128,6 +132,9 @@ enum Command {
         flow_index: Option<f64>,
         #[arg(long, default_value_t = 400_000)]
         max_steps: u64,
+        /// Threads for the solver (bands of rows; 2 uses both cores of a two-core machine).
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
         #[arg(long)]
         out: PathBuf,
     },
@@ -186,7 +193,9 @@ fn main() -> ExitCode {
             yield_stress,
             consistency,
             flow_index,
+            pressure_gradient,
             max_steps,
+            threads,
             out,
         }) => flow::flow(flow::FlowOptions {
             case,
@@ -200,7 +209,9 @@ fn main() -> ExitCode {
             yield_stress,
             consistency,
             flow_index,
+            pressure_gradient,
             max_steps,
+            threads,
             out,
         }),
         Some(Command::Info { design }) => overview(&design.unwrap_or_else(default_design)),

@@ -559,3 +559,70 @@ fn flow_writes_fields_profiles_and_picture_and_finds_the_vortex() {
     ]);
     assert_bad_input(&out, &["--rpm -3"]);
 }
+
+#[test]
+fn flow_channel_shows_the_plug_of_a_yield_stress_slurry() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "channel",
+        "--material",
+        "ceramic-slurry",
+        "--pressure-gradient",
+        "0.5",
+        "--cells",
+        "48",
+        "--threads",
+        "2",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let s = text(&out.stdout);
+    let numbers = |prefix: &str| -> Vec<f64> {
+        let line = s
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("{s}"));
+        line.split(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .filter_map(|t| t.parse().ok())
+            .collect()
+    };
+    // τ₀ = 300 Pa at 0.5 MPa/m: y₀ = 0.6 mm of the 2 mm half-gap.
+    let plug = numbers("plug (stress below the yield stress): half-width");
+    assert!((plug[1] - 0.6).abs() < 1e-9, "{s}");
+    assert!(
+        (plug[0] - 0.6).abs() < 0.1,
+        "measured plug {} mm: {s}",
+        plug[0]
+    );
+    let profile = numbers("profile within");
+    assert!(profile[0] < 5.0, "{s}");
+    assert!(
+        s.contains("flow rate") && s.contains("converged after"),
+        "{s}"
+    );
+    let cu = std::fs::read_to_string(dir.path().join("centerline_u.csv")).unwrap();
+    assert_eq!(cu.lines().count(), 49);
+    assert!(dir.path().join("speed.png").exists());
+    // Too little pressure to make the slurry yield, and a bad thread count.
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "channel",
+        "--pressure-gradient",
+        "0.1",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_bad_input(&out, &["--pressure-gradient 0.1", "does not yield"]);
+    let out = clayloft(&[
+        "flow",
+        "--threads",
+        "0",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_bad_input(&out, &["--threads 0"]);
+}

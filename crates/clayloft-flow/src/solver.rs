@@ -7,7 +7,7 @@
 // by the same i: a range loop says that most plainly.
 #![allow(clippy::needless_range_loop)]
 
-use crate::collision::{ConstantRate, Relaxation, ShearDependent};
+use crate::collision::{ConstantRate, Relaxation, ShearDependent, moments, shear_rate_squared};
 use crate::kernel::{self, Row};
 use crate::lattice::{C, OPP, Stored, W, shift, unshift};
 use crate::parallel::{SpinBarrier, band_starts};
@@ -391,18 +391,56 @@ impl Solver {
         (u, v)
     }
 
-    /// Fraction of cells whose relaxation time sits at a clamp (for non-Newtonian fluids).
-    pub fn clamped_fraction(&self) -> f64 {
-        if self.fluid.is_newtonian() {
-            return 0.0;
+    /// The magnitude of the (kinematic) shear stress at every node, row-major from the bottom:
+    /// `|σ| = ν·γ̇`, with γ̇ from the non-equilibrium moments of the populations arriving at
+    /// the node for the next step (as the next collision will see them) and ν = (1/ω − ½)/3
+    /// from the node's relaxation rate. Where `|σ|` is below a slurry's yield stress, the slurry
+    /// does not yield: the plug.
+    pub fn shear_stresses(&self) -> Vec<f64> {
+        let n = self.n();
+        let frame = Frame {
+            nx: self.nx,
+            ny: self.ny,
+            bounds: self.bounds,
+        };
+        let src: [&[Stored]; 9] = std::array::from_fn(|i| &self.f[i * n..(i + 1) * n]);
+        let mut out = Vec::with_capacity(n);
+        for y in 0..self.ny {
+            for x in 0..self.nx {
+                let omega = self.omega[y * self.nx + x];
+                let f = frame.pull_at_wall(&src, x, y);
+                let m = if self.bounds.force_x != 0.0 {
+                    moments::<true>(&f, self.bounds.force_x)
+                } else {
+                    moments::<false>(&f, 0.0)
+                };
+                let gamma = shear_rate_squared(&f, m, omega).sqrt();
+                out.push((1.0 / omega - 0.5) / 3.0 * gamma);
+            }
         }
-        let at = self
-            .omega
-            .iter()
-            .map(|w| 1.0 / w)
-            .filter(|t| *t <= self.tau_min * (1.0 + 1e-12) || *t >= self.tau_max * (1.0 - 1e-12))
-            .count();
-        at as f64 / self.n() as f64
+        out
+    }
+
+    /// Fractions of cells whose relaxation time sits at the lower and at the upper clamp (for
+    /// non-Newtonian fluids; cells at the upper one are, for practical purposes, unyielded).
+    pub fn clamped_fractions(&self) -> (f64, f64) {
+        if self.fluid.is_newtonian() {
+            return (0.0, 0.0);
+        }
+        let (mut low, mut high) = (0, 0);
+        for w in &self.omega {
+            let tau = 1.0 / w;
+            low += usize::from(tau <= self.tau_min * (1.0 + 1e-6));
+            high += usize::from(tau >= self.tau_max * (1.0 - 1e-6));
+        }
+        let n = self.n() as f64;
+        (low as f64 / n, high as f64 / n)
+    }
+
+    /// Fraction of cells whose relaxation time sits at either clamp.
+    pub fn clamped_fraction(&self) -> f64 {
+        let (low, high) = self.clamped_fractions();
+        low + high
     }
 
     /// Runs until the velocity changes by less than `tol` (max over cells, relative to `scale`)
@@ -544,6 +582,28 @@ mod tests {
             // Something happened: the lid or the force moved the fluid.
             let (u, _) = fast.velocity();
             assert!(u.iter().any(|u| u.abs() > 1e-4), "{fluid:?}: fluid at rest");
+        }
+    }
+
+    #[test]
+    fn channel_stress_grows_linearly_from_the_centre() {
+        // Momentum balance of a channel: |σ| = G·|y| whatever the fluid.
+        let (ny, g) = (20, 1e-5);
+        for fluid in [
+            Fluid::Newtonian { nu: 1.0 / 6.0 },
+            Fluid::PowerLaw { k: 0.05, n: 0.6 },
+        ] {
+            let mut s = Solver::new(3, ny, fluid, Boundaries::channel(g), 0.505, 10.0);
+            s.run_to_convergence(1000, 1e-7, 200_000, 1e-3, |_, _| {});
+            let stress = s.shear_stresses();
+            for y in [2, 5, 14, 17] {
+                let want = g * (y as f64 + 0.5 - ny as f64 / 2.0).abs();
+                let got = stress[y * 3 + 1];
+                assert!(
+                    (got - want).abs() < 0.03 * want,
+                    "{fluid:?} row {y}: {got:e} vs {want:e}"
+                );
+            }
         }
     }
 

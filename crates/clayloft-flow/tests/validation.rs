@@ -1,6 +1,7 @@
 //! Validation against known solutions: Ghia, Ghia & Shin (1982) lid-driven cavity; analytic
 //! power-law and Herschel–Bulkley channel flow; a mirror-symmetric Stokes cavity.
 
+use clayloft_flow::analysis::plane_poiseuille;
 use clayloft_flow::{Boundaries, Fluid, Solver};
 
 /// Ghia et al. (1982) Table I: u along the vertical centre line (y, u at Re = 100, u at Re = 1000).
@@ -121,12 +122,6 @@ fn channel(fluid: Fluid, ny: usize, g: f64, tau_max: f64) -> Vec<f64> {
     (0..ny).map(|y| s.macroscopic(1, y).1).collect()
 }
 
-/// Power law: u(y) = n/(n+1)·(G/K)^(1/n)·(h^α − |y|^α), α = (n+1)/n, y from the centre line.
-fn power_law_profile(n: f64, k: f64, g: f64, h: f64, y: f64) -> f64 {
-    let a = (n + 1.0) / n;
-    n / (n + 1.0) * (g / k).powf(1.0 / n) * (h.powf(a) - y.abs().powf(a))
-}
-
 #[test]
 fn power_law_channel_matches_the_analytic_profile() {
     for n in [0.5, 1.5] {
@@ -143,7 +138,7 @@ fn power_law_channel_matches_the_analytic_profile() {
         let worst = (0..ny)
             .map(|j| {
                 let y = j as f64 + 0.5 - h;
-                (u[j] - power_law_profile(n, k, g, h, y)).abs() / u_max
+                (u[j] - plane_poiseuille(0.0, k, n, g, h, y)).abs() / u_max
             })
             .fold(0.0, f64::max);
         assert!(
@@ -167,10 +162,7 @@ fn herschel_bulkley_channel_has_the_analytic_plug() {
     let tau0 = g * y0;
     let u = channel(Fluid::HerschelBulkley { tau0, k, n, m: 1e5 }, ny, g, 10.0);
     // Bingham (n = 1): u = G/(2K)·[(h − y₀)² − (|y| − y₀)²] outside the plug, u(y₀) inside.
-    let exact = |y: f64| {
-        let yy = y.abs().max(y0);
-        g / (2.0 * k) * ((h - y0).powi(2) - (yy - y0).powi(2))
-    };
+    let exact = |y: f64| plane_poiseuille(tau0, k, n, g, h, y);
     let u_plug = exact(0.0);
     let mut worst: f64 = 0.0;
     let mut plug_spread: f64 = 0.0;

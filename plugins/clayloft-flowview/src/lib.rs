@@ -1,7 +1,7 @@
 //! The flow view (SPEC §8 "Teaching", §10): the clay in the screw groove, simulated live on a
 //! background thread while the student changes the screw speed, the groove and the material.
-//! Speed as colour, u and v along the centre lines as curves, the vortex centre and the dead
-//! zones, with short explanations.
+//! Speed as colour with streamlines, u and v along the centre lines as plots (egui_plot), the
+//! vortex centre and the dead zones, with short explanations.
 
 use std::sync::Arc;
 use std::sync::Mutex;
@@ -10,12 +10,13 @@ use std::sync::mpsc::{Receiver, channel};
 
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
-use clayloft_flow::analysis::{dead_cells, vortex_centre};
+use clayloft_flow::analysis::{dead_cells, speed_colour, streamlines, vortex_centre};
 use clayloft_flow::groove::{Groove, MATERIALS};
 use clayloft_flow::{Boundaries, Solver};
 
-/// Lattice cells across the groove in the live view (the command line defaults to 120).
-const CELLS: usize = 48;
+/// Lattice cells across the groove in the live view (the command line defaults to 120): fine
+/// enough to show the corner eddies, coarse enough to converge in a few seconds on one core.
+const CELLS: usize = 64;
 
 /// The settings a student changes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,6 +53,8 @@ pub struct Snapshot {
     pub clamped: f64,
     pub reynolds: f64,
     pub cell_mm: f64,
+    /// Streamlines in cells (x, y from the lower left).
+    pub lines: Vec<Vec<(f64, f64)>>,
 }
 
 struct Run {
@@ -94,9 +97,7 @@ fn start(s: FlowSettings) -> Run {
         let mut solver = Solver::new(l.nx, l.ny, l.fluid, Boundaries::cavity(l.lid_u), 0.51, 10.0);
         let mut prev: Option<Vec<f64>> = None;
         while !flag.load(Ordering::Relaxed) {
-            for _ in 0..500 {
-                solver.step();
-            }
+            solver.advance(500);
             let (u, v) = solver.velocity();
             let change = prev
                 .as_ref()
@@ -119,6 +120,7 @@ fn start(s: FlowSettings) -> Run {
                 clamped: solver.clamped_fraction(),
                 reynolds: l.reynolds,
                 cell_mm: l.dx * 1e3,
+                lines: streamlines(&u, &v, l.nx, l.ny, 7, 1e-4 * l.lid_u),
             };
             if tx.send(snap).is_err() || (change < 1e-6 && solver.steps > 20_000) {
                 break;
@@ -147,50 +149,78 @@ fn speed_image(s: &Snapshot) -> egui::ColorImage {
     for y in 0..s.ny {
         for x in 0..s.nx {
             let k = y * s.nx + x;
-            let sp = s.u[k].hypot(s.v[k]).clamp(0.0, 1.0).sqrt();
-            img.pixels[(s.ny - 1 - y) * s.nx + x] = egui::Color32::from_rgb(
-                (255.0 * sp) as u8,
-                (40.0 + 180.0 * sp) as u8,
-                (40.0 + 120.0 * (1.0 - sp)) as u8,
-            );
+            let [r, g, b] = speed_colour(s.u[k].hypot(s.v[k]));
+            img.pixels[(s.ny - 1 - y) * s.nx + x] = egui::Color32::from_rgb(r, g, b);
         }
     }
     img
 }
 
-/// A small line plot of (t, value) pairs, t in 0..1, value in −1..1.
-fn plot(ui: &mut egui::Ui, label: &str, points: &[(f64, f64)], vertical: bool) {
-    ui.label(label);
-    let (rect, _) = ui.allocate_exact_size(egui::vec2(150.0, 150.0), egui::Sense::hover());
-    let p = ui.painter_at(rect);
-    p.rect_stroke(
-        rect,
-        0.0,
-        egui::Stroke::new(1.0, egui::Color32::DARK_GRAY),
-        egui::StrokeKind::Inside,
-    );
-    let at = |t: f64, val: f64| {
-        let (a, b) = if vertical {
-            (0.5 + 0.5 * val, 1.0 - t)
-        } else {
-            (t, 0.5 - 0.5 * val)
-        };
+/// The speed picture with the streamlines drawn over it.
+fn speed_with_streamlines(ui: &mut egui::Ui, tex: &egui::TextureHandle, snap: &Snapshot) {
+    let size = egui::vec2(240.0, 240.0 * snap.ny as f32 / snap.nx as f32);
+    let response = ui.image((tex.id(), size));
+    let rect = response.rect;
+    let painter = ui.painter_at(rect);
+    let to_screen = |(x, y): (f64, f64)| {
         egui::pos2(
-            rect.left() + a as f32 * rect.width(),
-            rect.top() + b as f32 * rect.height(),
+            rect.left() + (x / snap.nx as f64) as f32 * rect.width(),
+            rect.bottom() - (y / snap.ny as f64) as f32 * rect.height(),
         )
     };
-    // The zero line (u = 0 or v = 0) along the whole length.
-    let axis = [at(0.0, 0.0), at(1.0, 0.0)];
-    p.line_segment(axis, egui::Stroke::new(1.0, egui::Color32::GRAY));
-    let pts: Vec<egui::Pos2> = points
+    let stroke = egui::Stroke::new(1.0, egui::Color32::from_white_alpha(170));
+    for line in &snap.lines {
+        painter.add(egui::Shape::line(
+            line.iter().map(|p| to_screen(*p)).collect(),
+            stroke,
+        ));
+    }
+    response.on_hover_text(
+        "Colour: speed, from still (dark blue) to the barrel's speed (yellow). White lines: streamlines, the paths the clay follows.",
+    );
+}
+
+/// A centre-line plot: `points` are (position across the groove 0…1, velocity in wall speeds);
+/// drawn with the position upwards when `vertical` (u along the vertical centre line).
+fn centre_line_plot(
+    ui: &mut egui::Ui,
+    id: &str,
+    title: &str,
+    points: &[(f64, f64)],
+    vertical: bool,
+) {
+    use egui_plot::{Line, Plot};
+    let series: Vec<[f64; 2]> = points
         .iter()
-        .map(|(t, v)| at(*t, v.clamp(-1.0, 1.0)))
+        .map(|&(t, val)| if vertical { [val, t] } else { [t, val] })
         .collect();
-    p.add(egui::Shape::line(
-        pts,
-        egui::Stroke::new(2.0, egui::Color32::from_rgb(240, 180, 60)),
-    ));
+    let (x_label, y_label) = if vertical {
+        ("u / wall speed", "height / depth")
+    } else {
+        ("position / width", "v / wall speed")
+    };
+    ui.vertical(|ui| {
+        ui.label(title);
+        Plot::new(id)
+            .width(190.0)
+            .height(190.0)
+            .x_axis_label(x_label)
+            .y_axis_label(y_label)
+            .include_x(if vertical { -0.5 } else { 0.0 })
+            .include_x(1.0)
+            .include_y(if vertical { 0.0 } else { -0.5 })
+            .include_y(if vertical { 1.0 } else { 0.5 })
+            .allow_drag(false)
+            .allow_zoom(false)
+            .allow_scroll(false)
+            .show(ui, |plot| {
+                plot.line(
+                    Line::new(title, series)
+                        .color(egui::Color32::from_rgb(240, 180, 60))
+                        .width(2.0),
+                );
+            });
+    });
 }
 
 fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> Result {
@@ -231,14 +261,17 @@ fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> R
         };
         ui.horizontal(|ui| {
             if let Some(tex) = &view.texture {
-                ui.image((tex.id(), egui::vec2(220.0, 220.0 * snap.ny as f32 / snap.nx as f32)));
+                speed_with_streamlines(ui, tex, snap);
             }
             let (nx, ny) = (snap.nx, snap.ny);
             let ucol: Vec<(f64, f64)> = (0..ny).map(|y| ((y as f64 + 0.5) / ny as f64, snap.u[y * nx + nx / 2])).collect();
             let vrow: Vec<(f64, f64)> = (0..nx).map(|x| ((x as f64 + 0.5) / nx as f64, snap.v[(ny / 2) * nx + x])).collect();
-            ui.vertical(|ui| plot(ui, "u along the vertical centre line", &ucol, true));
-            ui.vertical(|ui| plot(ui, "v along the horizontal centre line", &vrow, false));
+            centre_line_plot(ui, "flow u", "u along the vertical centre line", &ucol, true);
+            centre_line_plot(ui, "flow v", "v along the horizontal centre line", &vrow, false);
         });
+        ui.label(egui::RichText::new(
+            "u: the clay under the barrel moves with it (u = 1 at the top) and flows back lower down (u < 0) — what goes round must come back. v: up on one side, down on the other: the vortex.",
+        ).small().weak());
         let (cx, cy) = vortex_centre(&snap.u, snap.nx, snap.ny);
         let (l, r) = dead_cells(&snap.u, &snap.v, snap.nx, snap.ny, 0.01);
         let a = snap.cell_mm * snap.cell_mm;
@@ -279,6 +312,27 @@ mod tests {
         let top = snap.u[(snap.ny - 1) * snap.nx + snap.nx / 2];
         assert!(top > 0.3, "{top}");
         assert_eq!(speed_image(&snap).pixels.len(), CELLS * CELLS);
+        // Later, the streamlines circle the vortex: some line reaches both the upper and the
+        // lower half of the groove.
+        let rx = run.rx.lock().unwrap();
+        let later = loop {
+            let snap = rx
+                .recv_timeout(std::time::Duration::from_secs(60))
+                .expect("more snapshots");
+            if snap.steps >= 20_000 {
+                break snap;
+            }
+        };
+        let mid = CELLS as f64 / 2.0;
+        assert!(
+            later
+                .lines
+                .iter()
+                .any(|l| l.iter().any(|p| p.1 > mid + 5.0) && l.iter().any(|p| p.1 < mid - 5.0)),
+            "{} streamlines, none round the vortex",
+            later.lines.len()
+        );
+        drop(rx);
         drop(run);
     }
 }
