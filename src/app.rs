@@ -48,6 +48,9 @@ pub fn run(design: Design, path: PathBuf, screenshot: Option<ScreenshotRequest>)
         app.insert_resource(clayloft_files::Autosave::new(
             std::env::temp_dir().join(format!("clayloft-screenshot-{}", std::process::id())),
         ));
+        if req.flow {
+            app.insert_resource(clayloft_flowview::FlowView::opened());
+        }
         app.add_plugins(ScreenshotPlugin(req));
     }
     match app.run() {

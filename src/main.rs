@@ -64,6 +64,9 @@ enum Command {
         width: u32,
         #[arg(long, default_value_t = 720)]
         height: u32,
+        /// Open the extruder-flow window and show its converged simulation.
+        #[arg(long)]
+        flow: bool,
     },
     /// Stream a G-code file to a printer (Marlin protocol) with a progress bar.
     Print {
@@ -221,12 +224,13 @@ fn main() -> ExitCode {
             progress,
             width,
             height,
+            flow,
         }) => shoot(
             design.unwrap_or_else(default_design),
             out,
             progress,
-            width,
-            height,
+            (width, height),
+            flow,
         ),
         None => editor(cli.design.unwrap_or_else(default_design)),
     };
@@ -373,8 +377,8 @@ fn shoot(
     design: PathBuf,
     out: PathBuf,
     progress: Option<f64>,
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
+    flow: bool,
 ) -> Result<ExitCode, Failure> {
     if let Some(f) = progress
         && !(0.0..=1.0).contains(&f)
@@ -395,6 +399,7 @@ fn shoot(
         settle_frames: 60,
         settle_time: std::time::Duration::from_secs(4),
         timeout: std::time::Duration::from_secs(300),
+        flow,
     };
     Ok(app::run(loaded.design, loaded.path, Some(req)))
 }

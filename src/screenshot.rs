@@ -25,6 +25,8 @@ pub struct ScreenshotRequest {
     pub settle_time: Duration,
     /// Give up (exit 2) if nothing was captured by then.
     pub timeout: Duration,
+    /// Open the extruder-flow window and wait for its simulation to converge.
+    pub flow: bool,
 }
 
 pub struct ScreenshotPlugin(pub ScreenshotRequest);
@@ -53,6 +55,7 @@ fn drive_screenshot(
     mut frames: Local<u32>,
     mut exit: MessageWriter<AppExit>,
     status: Res<clayloft_model::ModelStatus>,
+    flow: Res<clayloft_flowview::FlowView>,
 ) {
     *frames += 1;
     let now = time.elapsed();
@@ -81,6 +84,16 @@ fn drive_screenshot(
         replay.active = true;
         replay.playing = false;
         replay.time_s = f.clamp(0.0, 1.0) * path.timeline.total_s();
+    }
+    // The flow window's simulation: wait until it has converged (or run long enough to show
+    // its vortex).
+    if req.flow
+        && !flow
+            .last
+            .as_ref()
+            .is_some_and(|s| s.change < 1e-6 || s.steps >= 60_000)
+    {
+        return;
     }
     let (frame0, t0) = *state.ready_at.get_or_insert((*frames, now));
     if *frames - frame0 < req.settle_frames || now - t0 < req.settle_time {

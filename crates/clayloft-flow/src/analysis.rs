@@ -188,7 +188,7 @@ mod tests {
             assert!(line.len() < 800, "a circle closes before the step limit");
         }
         // Still fluid: no lines.
-        assert!(streamlines(&vec![0.0; 4], &vec![0.0; 4], 2, 2, 2, 1e-6).is_empty());
+        assert!(streamlines(&[0.0; 4], &[0.0; 4], 2, 2, 2, 1e-6).is_empty());
     }
 
     #[test]

@@ -370,7 +370,7 @@ impl Solver {
     /// same density and momentum as the pre-collision ones, less half the force).
     pub fn macroscopic(&self, x: usize, y: usize) -> (f64, f64, f64) {
         let (n, cell) = (self.n(), y * self.nx + x);
-        let fi: Vec<f64> = (0..9).map(|i| unshift(i, self.f[i * n + cell])).collect();
+        let fi: [f64; 9] = std::array::from_fn(|i| unshift(i, self.f[i * n + cell]));
         let rho: f64 = fi.iter().sum();
         let jx = fi[1] - fi[3] + fi[5] - fi[6] - fi[7] + fi[8] + 0.5 * self.bounds.force_x;
         let jy = fi[2] - fi[4] + fi[5] + fi[6] - fi[7] - fi[8];

@@ -66,11 +66,23 @@ struct Run {
 /// The window's state.
 #[derive(Resource, Default)]
 pub struct FlowView {
+    /// Whether the window starts expanded (it starts collapsed, and simulates nothing until
+    /// the student opens it).
     pub open: bool,
     pub settings: FlowSettings,
     run: Option<Run>,
     pub last: Option<Snapshot>,
     texture: Option<egui::TextureHandle>,
+}
+
+impl FlowView {
+    /// The window expanded from the start, running the default settings.
+    pub fn opened() -> FlowView {
+        FlowView {
+            open: true,
+            ..Default::default()
+        }
+    }
 }
 
 impl Drop for Run {
@@ -227,7 +239,7 @@ fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> R
     let ctx = contexts.ctx_mut()?.clone();
     let view = &mut *view;
     egui::Window::new("Extruder flow")
-        .default_open(false)
+        .default_open(view.open)
         .pivot(egui::Align2::LEFT_BOTTOM)
         .default_pos(egui::pos2(470.0, 690.0))
         .show(&ctx, |ui| {
