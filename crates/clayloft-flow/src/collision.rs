@@ -24,12 +24,13 @@ pub trait Relaxation: Copy + Send + Sync {
     /// root is part of the law's cheaper single-precision arithmetic.
     fn omega_at(&self, gamma_sq: f64) -> f64;
 
-    /// ω at each of the squared shear rates `gamma_sq` (at most [`CHUNK`] of them).
+    /// ω at each of the squared shear rates `gamma_sq` (at most [`CHUNK`] of them, in single
+    /// precision: see [`single_precision_rate`]).
     #[inline(always)]
-    fn omega_at_each(&self, gamma_sq: &[f64], omega: &mut [f64]) {
+    fn omega_at_each(&self, gamma_sq: &[f32], omega: &mut [f64]) {
         let omega = &mut omega[..gamma_sq.len()];
         for k in 0..gamma_sq.len() {
-            omega[k] = self.omega_at(gamma_sq[k]);
+            omega[k] = self.omega_at(gamma_sq[k] as f64);
         }
     }
 }
@@ -104,7 +105,7 @@ impl Relaxation for ShearDependent {
     #[inline(always)]
     fn omega_at(&self, gamma_sq: f64) -> f64 {
         let [k, n, tau0, m, lo, hi] = self.single();
-        let g = fastmath::clamp((gamma_sq as f32).sqrt(), GAMMA_MIN, f32::MAX);
+        let g = fastmath::clamp(single_precision_rate(gamma_sq).sqrt(), GAMMA_MIN, f32::MAX);
         let power = k * fastmath::exp(n * fastmath::ln(g));
         let yielded = tau0 * fastmath::one_minus_exp_neg(m * g);
         fastmath::clamp(g / (3.0 * (power + yielded) + 0.5 * g), lo, hi) as f64
@@ -113,7 +114,7 @@ impl Relaxation for ShearDependent {
     /// The same law in three passes — the logarithm, the power, then the yield term and ω — so
     /// that each pass is a short chain the processor can overlap across many nodes.
     #[inline(always)]
-    fn omega_at_each(&self, gamma_sq: &[f64], omega: &mut [f64]) {
+    fn omega_at_each(&self, gamma_sq: &[f32], omega: &mut [f64]) {
         let [k, n, tau0, m, lo, hi] = self.single();
         let len = gamma_sq.len();
         let omega = &mut omega[..len];
@@ -121,7 +122,7 @@ impl Relaxation for ShearDependent {
         let mut power = [0.0f32; CHUNK];
         let (g, power) = (&mut g[..len], &mut power[..len]);
         for i in 0..len {
-            g[i] = fastmath::clamp((gamma_sq[i] as f32).sqrt(), GAMMA_MIN, f32::MAX);
+            g[i] = fastmath::clamp(gamma_sq[i].sqrt(), GAMMA_MIN, f32::MAX);
             power[i] = fastmath::ln(g[i]);
         }
         for i in 0..len {
@@ -166,6 +167,14 @@ pub fn moments<const FORCED: bool>(f: &[f64; 9], force_x: f64) -> Moments {
         ux: jx * inv_rho,
         uy: jy * inv_rho,
     }
+}
+
+/// γ̇² in single precision for the viscosity law, floored at GAMMA_MIN² first so that a still
+/// node never makes a subnormal float (slow on x86).
+#[inline(always)]
+pub fn single_precision_rate(gamma_sq: f64) -> f32 {
+    const FLOOR: f64 = (GAMMA_MIN as f64) * (GAMMA_MIN as f64);
+    (if gamma_sq > FLOOR { gamma_sq } else { FLOOR }) as f32
 }
 
 /// Squared shear rate of a node from its non-equilibrium momentum flux, using its relaxation
@@ -273,7 +282,10 @@ mod tests {
                     g *= 1.37;
                 }
                 let mut each = vec![0.0; gammas.len()];
-                let squares: Vec<f64> = gammas.iter().map(|g| g * g).collect();
+                let squares: Vec<f32> = gammas
+                    .iter()
+                    .map(|g| single_precision_rate(g * g))
+                    .collect();
                 law.omega_at_each(&squares, &mut each);
                 for (&g, &passes) in gammas.iter().zip(&each) {
                     let want = 1.0 / tau_of(fluid.viscosity(g)).clamp(tau_min, tau_max);

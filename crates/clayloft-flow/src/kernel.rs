@@ -4,7 +4,10 @@
 //! the baseline — and the widest the CPU has is chosen at run time, so the binary stays portable.
 //! No fused multiply–adds are used, so every variant gives the same numbers bit for bit.
 
-use crate::collision::{CHUNK, Relaxation, moments, relax_towards_equilibrium, shear_rate_squared};
+use crate::collision::{
+    CHUNK, Relaxation, moments, relax_towards_equilibrium, shear_rate_squared,
+    single_precision_rate,
+};
 use crate::lattice::{Stored, shift, unshift};
 
 /// Writes the nine populations of node x.
@@ -148,7 +151,7 @@ fn sweep_slices<R: Relaxation, const FORCED: bool>(
     let mut rho = [0.0; CHUNK];
     let mut ux = [0.0; CHUNK];
     let mut uy = [0.0; CHUNK];
-    let mut gamma_sq = [0.0; CHUNK];
+    let mut gamma_sq = [0.0f32; CHUNK];
     let mut start = 0;
     while start < len {
         let m = CHUNK.min(len - start);
@@ -156,7 +159,7 @@ fn sweep_slices<R: Relaxation, const FORCED: bool>(
             let f = load!(start + k);
             let node = moments::<FORCED>(&f, force_x);
             (rho[k], ux[k], uy[k]) = (node.rho, node.ux, node.uy);
-            gamma_sq[k] = shear_rate_squared(&f, node, omega_old[start + k]);
+            gamma_sq[k] = single_precision_rate(shear_rate_squared(&f, node, omega_old[start + k]));
         }
         relax.omega_at_each(&gamma_sq[..m], &mut omega_new[start..start + m]);
         for k in 0..m {

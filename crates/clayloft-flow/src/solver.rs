@@ -133,10 +133,11 @@ impl Solver {
         let starts = band_starts(self.ny, self.threads);
         let bands = starts.len() - 1;
         if bands == 1 {
+            let mut walls = WallNodes::new(&frame, 0..self.ny);
             for _ in 0..steps {
                 let (src, dst) = split_directions(&self.f, &mut self.g, 0..self.ny, self.nx);
                 let omega = (&self.omega[..], &mut self.omega_next[..]);
-                frame.update_rows::<R, FORCED>(src, dst, omega, 0..self.ny, &relax);
+                frame.update_rows::<R, FORCED>(src, dst, omega, &mut walls, &relax);
                 self.swap();
             }
         } else {
@@ -149,11 +150,12 @@ impl Solver {
             let barrier = SpinBarrier::new(bands);
             let band = |k: usize| {
                 let rows = starts[k]..starts[k + 1];
+                let mut walls = WallNodes::new(&frame, rows.clone());
                 for s in 0..steps {
                     // SAFETY: see `SharedLattices`; the barrier ends every step.
                     unsafe {
                         let (src, dst, omega) = shared.band((s % 2) as usize, rows.clone());
-                        frame.update_rows::<R, FORCED>(src, dst, omega, rows.clone(), &relax);
+                        frame.update_rows::<R, FORCED>(src, dst, omega, &mut walls, &relax);
                     }
                     barrier.wait();
                 }
@@ -206,24 +208,25 @@ struct Frame {
 }
 
 impl Frame {
-    /// Streams from `src` (each direction whole) and collides the rows `rows`, writing them to
-    /// `dst` (those rows of each direction); `omega` holds those rows' relaxation rates from the
-    /// last step and receives the new ones.
+    /// Streams from `src` (each direction whole) and collides the band's rows (`walls.rows`),
+    /// writing them to `dst` (those rows of each direction); `omega` holds those rows' relaxation
+    /// rates from the last step and receives the new ones.
     ///
     /// The interior of the band is one flat run from node (1, first interior row) to node
     /// (nx − 2, last interior row), so the vectorised kernel sees long runs with one remainder.
     /// The run also passes the side nodes x = 0 and x = nx − 1 of the rows in between, where the
     /// pull reads the neighbouring row's far side; those nodes, and the top and bottom rows, are
-    /// then done again properly with [`Frame::pull_at_wall`] (each node's update reads only the last
-    /// step, so doing one twice is harmless).
+    /// then done again properly with [`Frame::pull_at_wall`] (each node's update reads only the
+    /// last step, so doing one twice is harmless).
     fn update_rows<R: Relaxation, const FORCED: bool>(
         &self,
         src: [&[Stored]; 9],
         mut dst: [&mut [Stored]; 9],
         (omega_old, omega_new): (&[f64], &mut [f64]),
-        rows: std::ops::Range<usize>,
+        walls: &mut WallNodes,
         relax: &R,
     ) {
+        let rows = walls.rows.clone();
         let (nx, ny) = (self.nx, self.ny);
         let (first, last) = (rows.start.max(1), rows.end.min(ny - 1));
         if nx >= 3 && first < last {
@@ -246,21 +249,16 @@ impl Frame {
             };
             kernel::sweep::<R, FORCED>(row, relax, self.bounds.force_x);
         }
-        // The nodes next to a wall: the sides of the interior rows, and whole top and bottom
-        // rows. Their pulled populations are gathered into scratch rows, collided by the same
-        // kernel, and scattered back.
-        let mut nodes = Vec::with_capacity(2 * rows.len() + 2 * nx);
-        for y in rows.clone() {
-            if y > 0 && y + 1 < ny && nx >= 3 {
-                nodes.extend([(0, y), (nx - 1, y)]);
-            } else {
-                nodes.extend((0..nx).map(|x| (x, y)));
-            }
-        }
+        // The nodes next to a wall: their pulled populations are gathered into scratch rows,
+        // collided by the same kernel, and scattered back.
+        let WallNodes {
+            nodes,
+            populations,
+            rates,
+            ..
+        } = walls;
         let m = nodes.len();
-        let mut populations: Vec<Stored> = vec![0.0; 18 * m];
         let (pulled, out) = populations.split_at_mut(9 * m);
-        let mut rates = vec![0.0; 2 * m];
         let (w_old, w_new) = rates.split_at_mut(m);
         for (k, &(x, y)) in nodes.iter().enumerate() {
             let f = self.pull_at_wall(&src, x, y);
@@ -312,6 +310,37 @@ impl Frame {
             };
         }
         f
+    }
+}
+
+/// The nodes of a band next to a wall — the sides of the interior rows, and whole top and bottom
+/// rows — and scratch rows for them, made once per stretch of steps.
+struct WallNodes {
+    rows: std::ops::Range<usize>,
+    nodes: Vec<(usize, usize)>,
+    /// Pulled populations, then the collided ones: 9 rows of `nodes.len()` each.
+    populations: Vec<Stored>,
+    /// Their old and new relaxation rates.
+    rates: Vec<f64>,
+}
+
+impl WallNodes {
+    fn new(frame: &Frame, rows: std::ops::Range<usize>) -> WallNodes {
+        let (nx, ny) = (frame.nx, frame.ny);
+        let mut nodes = Vec::with_capacity(2 * rows.len() + 2 * nx);
+        for y in rows.clone() {
+            if y > 0 && y + 1 < ny && nx >= 3 {
+                nodes.extend([(0, y), (nx - 1, y)]);
+            } else {
+                nodes.extend((0..nx).map(|x| (x, y)));
+            }
+        }
+        WallNodes {
+            rows,
+            populations: vec![0.0; 18 * nodes.len()],
+            rates: vec![0.0; 2 * nodes.len()],
+            nodes,
+        }
     }
 }
 
