@@ -32,6 +32,38 @@ pub struct Design {
     pub base_dir: Option<std::path::PathBuf>,
 }
 
+impl Design {
+    /// The design as it must be written to a file in folder `dir`: image and SVG contour paths,
+    /// relative to [`Design::base_dir`], rewritten relative to `dir` (with `..` where needed;
+    /// absolute where no relative path exists, as across Windows drives), and `base_dir` set to
+    /// `dir`. Absolute paths, and a design that has no folder yet, are left as they are.
+    pub fn moved_to(&self, dir: &std::path::Path) -> Design {
+        let mut moved = self.clone();
+        moved.base_dir = Some(dir.to_path_buf());
+        let Some(from) = self.base_dir.as_deref() else {
+            return moved;
+        };
+        let absolute = |p: &std::path::Path| std::path::absolute(p).unwrap_or(p.to_path_buf());
+        let (from, to) = (absolute(from), absolute(dir));
+        if from == to {
+            return moved;
+        }
+        for spec in [&mut moved.shape.lower, &mut moved.shape.upper] {
+            if let ContourSpec::Image { path, .. } | ContourSpec::Svg { path, .. } = spec {
+                let file = std::path::Path::new(path.as_str());
+                if file.is_absolute() {
+                    continue;
+                }
+                let target = from.join(file);
+                let rebased = pathdiff::diff_paths(&target, &to).unwrap_or(target);
+                // Forward slashes keep the file portable between systems.
+                *path = rebased.to_string_lossy().replace('\\', "/");
+            }
+        }
+        moved
+    }
+}
+
 /// Two designs are equal when their files would say the same (the folder they came from aside).
 impl PartialEq for Design {
     fn eq(&self, o: &Design) -> bool {

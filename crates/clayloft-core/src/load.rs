@@ -307,6 +307,45 @@ mod tests {
     }
 
     #[test]
+    fn a_design_moved_to_another_folder_still_finds_its_pictures() {
+        use crate::design::ContourSpec;
+        let root = tempfile::tempdir().unwrap();
+        let leaf =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/contours/leaf.png");
+        std::fs::create_dir_all(root.path().join("a/pictures")).unwrap();
+        std::fs::create_dir_all(root.path().join("b/deep")).unwrap();
+        std::fs::copy(&leaf, root.path().join("a/pictures/leaf.png")).unwrap();
+        let src = MINIMAL.replace(
+            "type = \"circle\"\nradius = 40.0",
+            "type = \"image\"\npath = \"pictures/leaf.png\"\nsize = 80.0",
+        );
+        let first = root.path().join("a/d.toml");
+        std::fs::write(&first, &src).unwrap();
+        let design = load_design(&first).unwrap().design;
+        // Save-as in another folder: the path now leads from there to the same picture.
+        let to = root.path().join("b/deep");
+        let moved = design.moved_to(&to);
+        let ContourSpec::Image { path, .. } = &moved.shape.lower else {
+            panic!("{:?}", moved.shape.lower)
+        };
+        assert_eq!(path, "../../a/pictures/leaf.png");
+        let second = to.join("d.toml");
+        std::fs::write(&second, moved.to_toml()).unwrap();
+        let reopened = load_design(&second).unwrap().design;
+        assert_eq!(reopened, moved);
+        let (a, b) = (crate::run(&design).unwrap(), crate::run(&reopened).unwrap());
+        assert_eq!(
+            a.toolpath.points, b.toolpath.points,
+            "the same outline, traced again"
+        );
+        // The same folder, absolute paths and designs without a folder stay as they are.
+        assert_eq!(design.moved_to(&root.path().join("a")), design);
+        let mut loose = design.clone();
+        loose.base_dir = None;
+        assert_eq!(loose.moved_to(&to), loose);
+    }
+
+    #[test]
     fn array_element_field_is_located() {
         let src = format!(
             "{MINIMAL}[[control.vertical]]\npoints = [[0.0, 0.0], [1.0, 1.0]]\n[[control.vertical]]\npoints = [\n  [0.0, 0.0],\n  [1.5, 2.0],\n]\n"

@@ -114,12 +114,19 @@ pub fn open_design(path: &Path) -> Result<Design, String> {
         .map_err(|e| e.to_string())
 }
 
-/// Saves a design as TOML, atomically, and checks that it loads back identical.
-pub fn save_design(design: &Design, path: &Path) -> Result<(), String> {
+/// Saves a design as TOML, atomically, and checks that it loads back identical. Saved in another
+/// folder, its picture and drawing paths are rewritten to lead from there to the same files
+/// ([`Design::moved_to`]); returns the design as saved.
+pub fn save_design(design: &Design, path: &Path) -> Result<Design, String> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let design = design.moved_to(dir);
     let text = design.to_toml();
     write_atomically(path, |w| w.write_all(text.as_bytes())).map_err(|e| e.to_string())?;
     match open_design(path) {
-        Ok(back) if back == *design => Ok(()),
+        Ok(back) if back == design => Ok(design),
         Ok(_) => Err(format!(
             "{}: saved file does not load back identical",
             path.display()
@@ -186,7 +193,8 @@ fn run_file_commands(
                     continue;
                 };
                 match save_design(&doc.design, &path) {
-                    Ok(()) => {
+                    Ok(saved) => {
+                        doc.design = saved;
                         let _ = std::fs::remove_file(autosave.path_for(doc.path.as_deref()));
                         autosave.written = Some(doc.design.clone());
                         autosave.pending_since = None;
@@ -224,7 +232,9 @@ fn restore_autosave(
         return;
     }
     match open_design(&path) {
-        Ok(d) if d != doc.design => {
+        Ok(mut d) if d != doc.design => {
+            // Its picture paths are relative to the document's folder, not the autosave's.
+            d.base_dir = doc.design.base_dir.clone();
             doc.design = d.clone();
             autosave.written = Some(d);
             status.ok(format!(
@@ -287,9 +297,17 @@ mod tests {
         for entry in std::fs::read_dir(design_path().parent().unwrap()).unwrap() {
             let p = entry.unwrap().path();
             let d = open_design(&p).unwrap();
+            // Saved elsewhere it loads back as saved and still finds its pictures and
+            // drawings: the same toolpath as the original.
             let out = dir.path().join(p.file_name().unwrap());
-            save_design(&d, &out).unwrap();
-            assert_eq!(open_design(&out).unwrap(), d, "{}", p.display());
+            let saved = save_design(&d, &out).unwrap();
+            let back = open_design(&out).unwrap();
+            assert_eq!(back, saved, "{}", p.display());
+            let (a, b) = (
+                clayloft_core::run(&d).unwrap(),
+                clayloft_core::run(&back).unwrap(),
+            );
+            assert_eq!(a.toolpath.points, b.toolpath.points, "{}", p.display());
         }
     }
 
@@ -312,7 +330,8 @@ mod tests {
     #[test]
     fn edits_are_autosaved_and_restored_after_a_kill() {
         let dir = tempfile::tempdir().unwrap();
-        let path = design_path();
+        // A design with picture contours: their paths must survive the round trip.
+        let path = design_path().with_file_name("leaf-dish.toml");
         let original = open_design(&path).unwrap();
         {
             let mut app = app(dir.path());
@@ -330,7 +349,7 @@ mod tests {
             app.update();
             // The app is dropped here without saving: as if killed.
         }
-        let auto = dir.path().join("pebble-spout.autosave.toml");
+        let auto = dir.path().join("leaf-dish.autosave.toml");
         assert_eq!(open_design(&auto).unwrap().shape.height, 90.0);
         let mut app = app(dir.path());
         app.insert_resource(DesignDoc {
@@ -344,6 +363,12 @@ mod tests {
         );
         let status = app.world().resource::<FileStatus>().clone();
         assert!(status.message.unwrap().contains("restored unsaved edits"));
+        let restored = app.world().resource::<DesignDoc>().design.clone();
+        assert_eq!(restored.base_dir, original.base_dir);
+        assert!(
+            clayloft_core::run(&restored).is_ok(),
+            "the restored design finds its picture"
+        );
         // Saving (elsewhere, not to touch the shipped design) removes the autosave.
         let saved = dir.path().join("saved.toml");
         app.world_mut()
@@ -351,7 +376,12 @@ mod tests {
             .write(FileCommand::Save(Some(saved.clone())));
         app.update();
         assert!(!auto.exists());
-        assert_eq!(open_design(&saved).unwrap().shape.height, 90.0);
+        let back = open_design(&saved).unwrap();
+        assert_eq!(back.shape.height, 90.0);
+        assert!(
+            clayloft_core::run(&back).is_ok(),
+            "saved elsewhere, it still finds its picture"
+        );
     }
 
     #[test]
