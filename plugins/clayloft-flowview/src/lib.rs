@@ -11,32 +11,76 @@ use std::sync::mpsc::{Receiver, channel};
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use clayloft_flow::analysis::{dead_cells, speed_colour, streamlines, vortex_centre};
-use clayloft_flow::groove::{Groove, MATERIALS};
+use clayloft_flow::groove::{Groove, MATERIALS, Material};
 use clayloft_flow::{Boundaries, Solver};
 
 /// Lattice cells across the groove in the live view (the command line defaults to 120): fine
 /// enough to show the corner eddies, coarse enough to converge in a few seconds on one core.
 const CELLS: usize = 64;
 
-/// The settings a student changes.
+/// The settings a student changes: the screw and groove, and the slurry — a preset
+/// ([`MATERIALS`]) whose yield stress, consistency and flow index can then be changed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlowSettings {
     pub rpm: f64,
     pub diameter_mm: f64,
     pub width_mm: f64,
     pub depth_mm: f64,
+    /// The preset the slurry started from (its density and source).
     pub material: usize,
+    /// Yield stress τ₀ (Pa), consistency K (Pa·sⁿ), flow index n.
+    pub tau0: f64,
+    pub k: f64,
+    pub n: f64,
 }
 
-impl Default for FlowSettings {
-    fn default() -> Self {
+impl FlowSettings {
+    /// The default groove with preset `material`.
+    pub fn with_material(material: usize) -> FlowSettings {
+        let m = MATERIALS[material.min(MATERIALS.len() - 1)];
         FlowSettings {
             rpm: 45.0,
             diameter_mm: 20.0,
             width_mm: 4.0,
             depth_mm: 4.0,
-            material: 2,
+            material,
+            tau0: m.tau0,
+            k: m.k,
+            n: m.n,
         }
+    }
+
+    /// The slurry: the preset with the chosen τ₀, K and n.
+    pub fn slurry(&self) -> Material {
+        Material {
+            tau0: self.tau0,
+            k: self.k,
+            n: self.n,
+            ..MATERIALS[self.material.min(MATERIALS.len() - 1)]
+        }
+    }
+
+    /// The same screw and groove with preset `material`'s slurry.
+    fn with_preset(&self, material: usize) -> FlowSettings {
+        let m = FlowSettings::with_material(material);
+        FlowSettings {
+            material,
+            tau0: m.tau0,
+            k: m.k,
+            n: m.n,
+            ..*self
+        }
+    }
+
+    /// Whether τ₀, K and n are still the preset's.
+    fn is_preset(&self) -> bool {
+        self.slurry() == MATERIALS[self.material.min(MATERIALS.len() - 1)]
+    }
+}
+
+impl Default for FlowSettings {
+    fn default() -> Self {
+        FlowSettings::with_material(2)
     }
 }
 
@@ -103,7 +147,7 @@ fn start(s: FlowSettings) -> Run {
             depth_m: s.depth_mm * 1e-3,
             screw_diameter_m: s.diameter_mm * 1e-3,
             rpm: s.rpm,
-            material: MATERIALS[s.material.min(MATERIALS.len() - 1)],
+            material: s.slurry(),
         };
         let l = g.to_lattice(CELLS, 1.0);
         let mut solver = Solver::new(l.nx, l.ny, l.fluid, Boundaries::cavity(l.lid_u), 0.51, 10.0);
@@ -251,11 +295,21 @@ fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> R
         ui.add(egui::Slider::new(&mut s.diameter_mm, 5.0..=60.0).text("screw diameter, mm"));
         ui.add(egui::Slider::new(&mut s.width_mm, 1.0..=10.0).text("groove width, mm"));
         ui.add(egui::Slider::new(&mut s.depth_mm, 1.0..=10.0).text("groove depth, mm"));
-        egui::ComboBox::from_label("material").selected_text(MATERIALS[s.material].name).show_ui(ui, |ui| {
+        let name = MATERIALS[s.material].name;
+        let label = if s.is_preset() { name.to_string() } else { format!("{name}, changed") };
+        egui::ComboBox::from_label("material").selected_text(label).show_ui(ui, |ui| {
             for (i, m) in MATERIALS.iter().enumerate() {
-                ui.selectable_value(&mut s.material, i, m.name).on_hover_text(m.source);
+                if ui.selectable_label(s.material == i && s.is_preset(), m.name).on_hover_text(m.source).clicked() {
+                    *s = s.with_preset(i);
+                }
             }
         });
+        ui.add(egui::Slider::new(&mut s.tau0, 0.0..=2000.0).text("yield stress τ₀, Pa"))
+            .on_hover_text("Below this stress the slurry stands still like a soft solid; above it, it flows. 0 = no yield stress.");
+        ui.add(egui::Slider::new(&mut s.k, 0.1..=2000.0).logarithmic(true).text("consistency K, Pa·s^n"))
+            .on_hover_text("How thick the slurry is: its viscosity at a shear rate of 1 per second.");
+        ui.add(egui::Slider::new(&mut s.n, 0.1..=1.5).text("flow index n"))
+            .on_hover_text("Below 1 the slurry thins the faster it is sheared (clay does); 1 is a plain (Newtonian) liquid; above 1 it thickens.");
         let settings = *s;
         if view.run.as_ref().map(|r| r.settings) != Some(settings) {
             view.run = Some(start(settings));
@@ -307,11 +361,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_changed_slurry_keeps_its_preset_for_the_rest() {
+        let mut s = FlowSettings::with_material(1);
+        assert!(s.is_preset());
+        assert_eq!(s.slurry(), MATERIALS[1]);
+        s.tau0 = 150.0;
+        assert!(!s.is_preset());
+        let m = s.slurry();
+        assert_eq!(
+            (m.tau0, m.k, m.n, m.rho),
+            (150.0, MATERIALS[1].k, MATERIALS[1].n, MATERIALS[1].rho)
+        );
+        // Picking a preset again keeps the screw and groove and restores its slurry.
+        let t = FlowSettings { rpm: 90.0, ..s }.with_preset(2);
+        assert_eq!((t.rpm, t.material), (90.0, 2));
+        assert!(t.is_preset());
+    }
+
+    #[test]
     fn the_background_run_sends_snapshots_and_stops_when_dropped() {
-        let run = start(FlowSettings {
-            material: 0,
-            ..Default::default()
-        });
+        let run = start(FlowSettings::with_material(0));
         let snap = run
             .rx
             .lock()
