@@ -1,6 +1,6 @@
-//! The interior row kernel: pull streaming and collision of a run of interior nodes, written as
-//! straight-line arithmetic over nine source and nine destination slices so that the compiler
-//! vectorises it across x. The same code is compiled three times — for AVX-512, for AVX2 and for
+//! The kernel: pull streaming and collision of a run of nodes (the interior of a band, or the
+//! gathered wall nodes), written as straight-line arithmetic over nine source and nine
+//! destination slices so that the compiler vectorises it across the run. The same code is compiled three times — for AVX-512, for AVX2 and for
 //! the baseline — and the widest the CPU has is chosen at run time, so the binary stays portable.
 //! No fused multiply–adds are used, so every variant gives the same numbers bit for bit.
 

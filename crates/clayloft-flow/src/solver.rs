@@ -1,10 +1,11 @@
 //! The D2Q9 BGK solver (the paper's equations 1–5): pull streaming and collision fused in one
 //! pass over two lattices; half-way bounce-back at walls half a cell outside the boundary nodes;
 //! the moving lid by Ladd's rule `fᵢ = f*_ī + 6wᵢρ cᵢ·u_w`; a periodic channel with Guo's body
-//! force; a per-cell relaxation time from the strain rate of the non-equilibrium moments.
+//! force; a per-node relaxation rate from the strain rate of the non-equilibrium moments
+//! ([`crate::collision`]); time steps on one thread or on bands of rows ([`crate::parallel`]).
 
-// The kernel walks the nine directions indexing several arrays (populations, equilibria, C, W)
-// by the same i: a range loop says that most plainly.
+// The wall nodes walk the nine directions indexing several arrays (populations, C, W, OPP) by
+// the same i: a range loop says that most plainly.
 #![allow(clippy::needless_range_loop)]
 
 use crate::collision::{ConstantRate, Relaxation, ShearDependent, moments, shear_rate_squared};
