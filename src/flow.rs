@@ -13,21 +13,53 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::Failure;
 
 /// Options of `clayloft flow`.
+#[derive(clap::Args, Debug)]
 pub struct FlowOptions {
+    /// cavity (Ghia benchmark, normalised), groove (the screw groove, physical units) or
+    /// channel (pushed through a slot by pressure: the plug of a yield-stress slurry).
+    #[arg(long, default_value = "groove")]
     pub case: String,
+    /// Lattice cells across the width.
+    #[arg(long, default_value_t = 120)]
     pub cells: usize,
+    /// Reynolds number of the cavity case.
+    #[arg(long, default_value_t = 100.0)]
     pub re: f64,
+    /// Screw speed, revolutions per minute.
+    #[arg(long, default_value_t = 45.0)]
     pub rpm: f64,
+    /// Screw diameter, mm.
+    #[arg(long = "diameter", value_name = "MM", default_value_t = 20.0)]
     pub diameter_mm: f64,
+    /// Groove width, mm.
+    #[arg(long = "width", value_name = "MM", default_value_t = 4.0)]
     pub width_mm: f64,
+    /// Groove depth, mm (for the channel: its gap).
+    #[arg(long = "depth", value_name = "MM", default_value_t = 4.0)]
     pub depth_mm: f64,
+    /// newtonian, clay-paste or ceramic-slurry.
+    #[arg(long, default_value = "ceramic-slurry")]
     pub material: String,
+    /// Yield stress τ₀, Pa (instead of the material's).
+    #[arg(long, value_name = "PA")]
     pub yield_stress: Option<f64>,
+    /// Consistency K, Pa·s^n (instead of the material's).
+    #[arg(long, value_name = "K")]
     pub consistency: Option<f64>,
+    /// Flow index n (instead of the material's): below 1 shear-thinning.
+    #[arg(long, value_name = "N")]
     pub flow_index: Option<f64>,
+    /// Pressure gradient along the channel, MPa/m.
+    #[arg(long, value_name = "MPA_PER_M", default_value_t = 0.5)]
     pub pressure_gradient: f64,
+    /// Stop after this many time steps, converged or not.
+    #[arg(long, default_value_t = 400_000)]
     pub max_steps: u64,
+    /// Threads for the solver (bands of rows; 2 uses both cores of a two-core machine).
+    #[arg(long, default_value_t = 1)]
     pub threads: usize,
+    /// Folder for the velocity fields, profiles and picture.
+    #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }
 

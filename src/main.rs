@@ -99,48 +99,7 @@ enum Command {
         log: Option<PathBuf>,
     },
     /// Simulate the clay in the extruder's screw groove (lattice Boltzmann) and write CSV + PNG.
-    Flow {
-        /// cavity (Ghia benchmark, normalised), groove (the screw groove, physical units) or
-        /// channel (pushed through a slot by pressure: the plug of a yield-stress slurry).
-        #[arg(long, default_value = "groove")]
-        case: String,
-        /// Lattice cells across the width.
-        #[arg(long, default_value_t = 120)]
-        cells: usize,
-        /// Reynolds number of the cavity case.
-        #[arg(long, default_value_t = 100.0)]
-        re: f64,
-        #[arg(long, default_value_t = 45.0)]
-        rpm: f64,
-        /// Screw diameter, mm.
-        #[arg(long, default_value_t = 20.0)]
-        diameter: f64,
-        /// Groove width and depth, mm (the channel's gap is the depth).
-        #[arg(long, default_value_t = 4.0)]
-        width: f64,
-        #[arg(long, default_value_t = 4.0)]
-        depth: f64,
-        /// Pressure gradient along the channel, MPa/m.
-        #[arg(long, default_value_t = 0.5)]
-        pressure_gradient: f64,
-        /// newtonian, clay-paste or ceramic-slurry.
-        #[arg(long, default_value = "ceramic-slurry")]
-        material: String,
-        /// Override the material: yield stress (Pa), consistency (Pa·sⁿ), flow index.
-        #[arg(long)]
-        yield_stress: Option<f64>,
-        #[arg(long)]
-        consistency: Option<f64>,
-        #[arg(long)]
-        flow_index: Option<f64>,
-        #[arg(long, default_value_t = 400_000)]
-        max_steps: u64,
-        /// Threads for the solver (bands of rows; 2 uses both cores of a two-core machine).
-        #[arg(long, default_value_t = 1)]
-        threads: usize,
-        #[arg(long)]
-        out: PathBuf,
-    },
+    Flow(flow::FlowOptions),
     /// Re-measure a G-code file against the printer limits (exit 0 = all hold, 1 = violations).
     Check {
         gcode: PathBuf,
@@ -184,39 +143,7 @@ fn main() -> ExitCode {
             vanish_after,
             log,
         }),
-        Some(Command::Flow {
-            case,
-            cells,
-            re,
-            rpm,
-            diameter,
-            width,
-            depth,
-            material,
-            yield_stress,
-            consistency,
-            flow_index,
-            pressure_gradient,
-            max_steps,
-            threads,
-            out,
-        }) => flow::flow(flow::FlowOptions {
-            case,
-            cells,
-            re,
-            rpm,
-            diameter_mm: diameter,
-            width_mm: width,
-            depth_mm: depth,
-            material,
-            yield_stress,
-            consistency,
-            flow_index,
-            pressure_gradient,
-            max_steps,
-            threads,
-            out,
-        }),
+        Some(Command::Flow(options)) => flow::flow(options),
         Some(Command::Info { design }) => overview(&design.unwrap_or_else(default_design)),
         Some(Command::Screenshot {
             design,
