@@ -359,15 +359,18 @@ fn control(ui: &mut egui::Ui, d: &mut Design) {
         ui,
         "Vertical lines push the wall out (or in) along its height; horizontal lines raise or lower a section around the vessel.",
     );
-    let mut remove = None;
-    for (l, v) in d.control.vertical.iter_mut().enumerate() {
-        ui.group(|ui| {
-            ui.horizontal(|ui| {
-                ui.strong(format!("Vertical line {l}"));
-                if ui.small_button("remove").clicked() {
-                    remove = Some(l);
-                }
-            });
+    let new_vertical = || VerticalLine {
+        points: vec![[0.0, 0.0], [0.5, 5.0], [1.0, 0.0]],
+        angle: None,
+        width: None,
+    };
+    removable_groups(
+        ui,
+        &mut d.control.vertical,
+        "Vertical line",
+        "+ vertical line",
+        new_vertical,
+        |ui, l, v| {
             let mut local = v.angle.is_some();
             if ui
                 .checkbox(&mut local, "local")
@@ -409,27 +412,20 @@ fn control(ui: &mut egui::Ui, d: &mut Design) {
                 ["", " mm"],
                 2,
             );
-        });
-    }
-    if let Some(l) = remove {
-        d.control.vertical.remove(l);
-    }
-    if ui.button("+ vertical line").clicked() {
-        d.control.vertical.push(VerticalLine {
-            points: vec![[0.0, 0.0], [0.5, 5.0], [1.0, 0.0]],
-            angle: None,
-            width: None,
-        });
-    }
-    let mut remove = None;
-    for (l, h) in d.control.horizontal.iter_mut().enumerate() {
-        ui.group(|ui| {
-            ui.horizontal(|ui| {
-                ui.strong(format!("Horizontal line {l}"));
-                if ui.small_button("remove").clicked() {
-                    remove = Some(l);
-                }
-            });
+        },
+    );
+    let new_horizontal = || HorizontalLine {
+        at: 1.0,
+        reach: 0.3,
+        points: vec![[0.0, 0.0], [90.0, 5.0], [180.0, 0.0], [270.0, 5.0]],
+    };
+    removable_groups(
+        ui,
+        &mut d.control.horizontal,
+        "Horizontal line",
+        "+ horizontal line",
+        new_horizontal,
+        |ui, l, h| {
             number(
                 ui,
                 "At",
@@ -458,17 +454,37 @@ fn control(ui: &mut egui::Ui, d: &mut Design) {
                 ["°", " mm"],
                 2,
             );
+        },
+    );
+}
+
+/// A list of items, each in its own group titled "`title` i" with a remove button, and a button
+/// that adds `new()` at the end.
+fn removable_groups<T>(
+    ui: &mut egui::Ui,
+    items: &mut Vec<T>,
+    title: &str,
+    add_label: &str,
+    new: impl FnOnce() -> T,
+    mut body: impl FnMut(&mut egui::Ui, usize, &mut T),
+) {
+    let mut remove = None;
+    for (i, item) in items.iter_mut().enumerate() {
+        ui.group(|ui| {
+            ui.horizontal(|ui| {
+                ui.strong(format!("{title} {i}"));
+                if ui.small_button("remove").clicked() {
+                    remove = Some(i);
+                }
+            });
+            body(ui, i, item);
         });
     }
-    if let Some(l) = remove {
-        d.control.horizontal.remove(l);
+    if let Some(i) = remove {
+        items.remove(i);
     }
-    if ui.button("+ horizontal line").clicked() {
-        d.control.horizontal.push(HorizontalLine {
-            at: 1.0,
-            reach: 0.3,
-            points: vec![[0.0, 0.0], [90.0, 5.0], [180.0, 0.0], [270.0, 5.0]],
-        });
+    if ui.button(add_label).clicked() {
+        items.push(new());
     }
 }
 
