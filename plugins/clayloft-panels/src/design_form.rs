@@ -728,3 +728,67 @@ fn printer(ui: &mut egui::Ui, d: &mut Design) {
         ui.selectable_value(&mut p.extrusion, ExtrusionMode::Absolute, "absolute");
     });
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable;
+
+    fn form() -> Harness<'static, Design> {
+        let design = clayloft_core::load::parse_design(
+            "version = 1\n[shape]\nheight = 60.0\nlower = { type = \"circle\", radius = 40.0 }\nupper = { type = \"circle\", radius = 45.0 }\n",
+        )
+        .unwrap();
+        Harness::builder()
+            .with_size(egui::vec2(420.0, 4000.0))
+            .build_ui_state(|ui, d: &mut Design| design_form(ui, d, None), design)
+    }
+
+    #[test]
+    fn control_lines_are_added_and_removed_from_the_form() {
+        let mut h = form();
+        h.get_by_label("Control lines").click();
+        h.run();
+        h.get_by_label("+ vertical line").click();
+        h.run();
+        h.get_by_label("+ vertical line").click();
+        h.run();
+        h.get_by_label("+ horizontal line").click();
+        h.run();
+        assert_eq!(h.state().control.vertical.len(), 2);
+        assert_eq!(h.state().control.horizontal.len(), 1);
+        assert!(h.query_by_label("Vertical line 1").is_some());
+        assert!(h.query_by_label("Horizontal line 0").is_some());
+        // The new lines make a valid design: the pipeline runs it.
+        assert!(clayloft_core::run(h.state()).is_ok());
+        // "remove" on the first group takes the first vertical line away.
+        h.get_all_by_label("remove").next().unwrap().click();
+        h.run();
+        assert_eq!(h.state().control.vertical.len(), 1);
+        assert_eq!(h.state().control.horizontal.len(), 1);
+        assert!(h.query_by_label("Vertical line 1").is_none());
+    }
+
+    #[test]
+    fn a_contour_type_and_a_texture_are_chosen_from_the_form() {
+        let mut h = form();
+        // The lower contour's type box shows "circle" (the upper one too: take the first).
+        h.get_all_by_value("circle").next().unwrap().click();
+        h.run();
+        h.get_by_label("star").click();
+        h.run();
+        assert!(matches!(
+            h.state().shape.lower,
+            ContourSpec::Star { points: 5, .. }
+        ));
+        assert!(matches!(h.state().shape.upper, ContourSpec::Circle { .. }));
+        h.get_by_label("Texture").click();
+        h.run();
+        h.get_by_label("textured").click();
+        h.run();
+        let texture = h.state().texture.clone().expect("a texture");
+        assert_eq!(texture.x.map(|w| w.period), Some(20.0));
+        assert!(clayloft_core::run(h.state()).is_ok());
+    }
+}
