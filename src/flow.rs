@@ -121,7 +121,9 @@ pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
         Fluid::Newtonian { nu } => nu,
         _ => 1.0 / 6.0,
     };
-    let min_steps = ((2.0 * (solver.ny * solver.ny) as f64 / nu_ref) as u64).min(o.max_steps);
+    // (Leaving at least one check of convergence within --max-steps.)
+    let min_steps = ((2.0 * (solver.ny * solver.ny) as f64 / nu_ref) as u64)
+        .min(o.max_steps.saturating_sub(1000));
     let started = std::time::Instant::now();
     while solver.steps < min_steps {
         solver.advance(1000.min(min_steps - solver.steps));
@@ -136,16 +138,24 @@ pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
     let converged = change < 1e-6;
     let lups =
         (steps * (solver.nx * solver.ny) as u64) as f64 / started.elapsed().as_secs_f64().max(1e-9);
+    let state = if converged {
+        format!(
+            "converged after {steps} steps (velocity change {change:.1e} of the velocity scale per 1000 steps)"
+        )
+    } else if change.is_finite() {
+        format!(
+            "stopped unconverged after {steps} steps (velocity change {change:.1e} of the velocity scale per 1000 steps)"
+        )
+    } else {
+        format!(
+            "stopped after {steps} steps, before the first check of convergence (raise --max-steps)"
+        )
+    };
     println!(
-        "{} after {steps} steps (velocity change {change:.1e} of the velocity scale per 1000 steps); {:.1} % of cells at the relaxation-time clamp; {:.0} million lattice updates/s on {} thread(s)",
-        if converged {
-            "converged"
-        } else {
-            "stopped unconverged"
-        },
+        "{state}; {:.1} % of cells at the relaxation-time clamp; {:.0} million lattice updates/s on {} thread(s)",
         solver.clamped_fraction() * 100.0,
         lups / 1e6,
-        o.threads,
+        solver.bands(),
     );
     let (u, v) = solver.velocity();
     let (nx, ny) = (solver.nx, solver.ny);
@@ -382,6 +392,11 @@ fn report_channel(solver: &Solver, c: &Channel, u: &[f64], to_ms: f64) {
         "profile within {:.1} % of the analytic Herschel–Bulkley profile (of the centre speed)",
         100.0 * worst / peak
     );
+    if worst > 0.1 * peak {
+        println!(
+            "  (the lattice is too coarse for this profile — a thin sheared layer or a strongly shear-thinning slurry: try more --cells)"
+        );
+    }
     if c.tau0_lu > 0.0 {
         println!(
             "plug (stress below the yield stress): half-width {:.3} mm; analytic y₀ = τ₀/G = {:.3} mm",

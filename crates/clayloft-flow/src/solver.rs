@@ -58,7 +58,9 @@ pub struct Solver {
     omega: Vec<f64>,
     omega_next: Vec<f64>,
     pub steps: u64,
-    /// Threads to run on (1 = one core): bands of rows that meet after every step.
+    /// Threads asked for (1 = one core): bands of rows that meet after every step. At most one
+    /// per core is used ([`Solver::bands`]): the threads wait for each other after every step, so
+    /// more than the machine can run at once would only take turns waiting.
     pub threads: usize,
 }
 
@@ -131,7 +133,7 @@ impl Solver {
             ny: self.ny,
             bounds: self.bounds,
         };
-        let starts = band_starts(self.ny, self.threads);
+        let starts = band_starts(self.ny, self.bands());
         let bands = starts.len() - 1;
         if bands == 1 {
             let mut walls = WallNodes::new(&frame, 0..self.ny);
@@ -173,6 +175,13 @@ impl Solver {
             }
         }
         self.steps += steps;
+    }
+
+    /// How many bands (threads) a step runs on: [`Solver::threads`], at most the machine's cores
+    /// and the lattice's rows.
+    pub fn bands(&self) -> usize {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        self.threads.clamp(1, cores.max(1)).min(self.ny.max(1))
     }
 
     /// The lattice just written becomes the one the next step reads.
@@ -486,9 +495,7 @@ impl Solver {
         let mut last = self.velocity();
         let mut change = f64::INFINITY;
         while self.steps < max_steps {
-            for _ in 0..every {
-                self.step();
-            }
+            self.advance(every.min(max_steps - self.steps));
             let now = self.velocity();
             change = now
                 .0
@@ -635,6 +642,27 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn threads_are_capped_and_step_limits_kept() {
+        let mut s = Solver::new(
+            10,
+            6,
+            Fluid::Newtonian { nu: 0.1 },
+            Boundaries::cavity(0.05),
+            0.51,
+            10.0,
+        );
+        s.threads = 1000;
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        assert_eq!(s.bands(), cores.min(6));
+        s.threads = 0;
+        assert_eq!(s.bands(), 1);
+        // The convergence loop stops at max_steps even between two of its checks.
+        let (steps, change) = s.run_to_convergence(1000, 1e-30, 2500, 0.05, |_, _| {});
+        assert_eq!((steps, s.steps), (2500, 2500));
+        assert!(change.is_finite() && change > 0.0);
     }
 
     #[test]
