@@ -180,8 +180,7 @@ impl Solver {
     /// How many bands (threads) a step runs on: [`Solver::threads`], at most the machine's cores
     /// and the lattice's rows.
     pub fn bands(&self) -> usize {
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        self.threads.clamp(1, cores.max(1)).min(self.ny.max(1))
+        self.threads.clamp(1, cores()).min(self.ny.max(1))
     }
 
     /// The lattice just written becomes the one the next step reads.
@@ -189,6 +188,12 @@ impl Solver {
         std::mem::swap(&mut self.f, &mut self.g);
         std::mem::swap(&mut self.omega, &mut self.omega_next);
     }
+}
+
+/// The machine's cores, asked once (the query reads cgroup files: slow next to a small step).
+fn cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 /// The nine directions of the source lattice (whole) and of the destination rows `rows`.
