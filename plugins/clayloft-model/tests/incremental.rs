@@ -49,6 +49,11 @@ fn drag(app: &mut App, role: HandleRole, delta: bevy::math::DVec3) {
     assert!(nudge_handle(app.world_mut(), role, delta));
 }
 
+/// How many entities have component `C`.
+fn count<C: Component>(app: &mut App) -> usize {
+    app.world_mut().query::<&C>().iter(app.world()).count()
+}
+
 #[test]
 fn first_frame_builds_everything_and_matches_the_pipeline() {
     let mut app = app_with(load("pebble-spout.toml"));
@@ -59,23 +64,11 @@ fn first_frame_builds_everything_and_matches_the_pipeline() {
     assert_eq!(log.sections, (0..=layers).collect::<Vec<_>>());
     assert_matches_pipeline(&mut app);
     // One entity per section, per handle (6 + 6 spline points, 3 + 3 line points), per line.
-    let sections = app
-        .world_mut()
-        .query::<&SectionIndex>()
-        .iter(app.world())
-        .count();
+    let sections = count::<SectionIndex>(&mut app);
     assert_eq!(sections, layers + 1);
-    let handles = app
-        .world_mut()
-        .query::<&EditHandle>()
-        .iter(app.world())
-        .count();
+    let handles = count::<EditHandle>(&mut app);
     assert_eq!(handles, 18);
-    let lines = app
-        .world_mut()
-        .query::<&ControlLine>()
-        .iter(app.world())
-        .count();
+    let lines = count::<ControlLine>(&mut app);
     assert_eq!(lines, 2);
 }
 
@@ -149,11 +142,7 @@ fn height_edit_replans_layers_and_respawns_sections() {
         .height -= 30.0;
     app.update();
     let layers = surface(&mut app).0.layers;
-    let sections = app
-        .world_mut()
-        .query::<&SectionIndex>()
-        .iter(app.world())
-        .count();
+    let sections = count::<SectionIndex>(&mut app);
     assert_eq!(sections, layers + 1);
     assert_matches_pipeline(&mut app);
 }
@@ -212,17 +201,9 @@ fn removing_a_control_line_removes_its_entities() {
         .remove(0);
     app.update();
     app.update();
-    let lines = app
-        .world_mut()
-        .query::<&ControlLine>()
-        .iter(app.world())
-        .count();
+    let lines = count::<ControlLine>(&mut app);
     assert_eq!(lines, 1);
-    let handles = app
-        .world_mut()
-        .query::<&EditHandle>()
-        .iter(app.world())
-        .count();
+    let handles = count::<EditHandle>(&mut app);
     assert_eq!(handles, 15);
     assert_matches_pipeline(&mut app);
 }
