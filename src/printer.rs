@@ -66,6 +66,11 @@ pub fn print(file: &Path, port: &str, baud: u32, timeout_s: f64) -> Result<ExitC
                 }
             }
             Event::Message(m) => last_message = m.clone(),
+            Event::PrinterError(m) => {
+                // Shown above the bar, kept in the terminal: the job goes on.
+                bar.println(format!("printer error (the job goes on): {m}"));
+                last_message = m.clone();
+            }
             _ => {}
         },
         |_| {},

@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use crate::line::{LineError, check_job, numbered};
-use crate::reply::{Reply, Temperatures, parse};
+use crate::reply::{HostAction, Reply, Temperatures, parse};
 
 /// Timeouts and limits of the protocol.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,6 +27,9 @@ pub struct SenderConfig {
     pub max_resends_of_one_line: u32,
     /// Numbered lines kept for resends.
     pub history: usize,
+    /// How long to wait for the `ok` that should follow a `Resend` before acting on the resend
+    /// anyway (Smoothieware never sends it; Marlin #18955, Prusa #331). OctoPrint waits 0.5 s.
+    pub resend_ok_grace: Duration,
 }
 
 impl Default for SenderConfig {
@@ -37,6 +40,7 @@ impl Default for SenderConfig {
             max_probes: 5,
             max_resends_of_one_line: 10,
             history: 64,
+            resend_ok_grace: Duration::from_millis(500),
         }
     }
 }
@@ -52,6 +56,9 @@ pub enum Event {
     Temperatures(Temperatures),
     /// A message from the printer worth showing.
     Message(String),
+    /// An error the printer reported that does not stop the job (a refused command, an unknown
+    /// `Error:`): shown prominently; the job goes on with the printer's next `ok`.
+    PrinterError(String),
     /// Every line was acknowledged.
     Finished,
     /// The job stopped, and why (one line).
@@ -82,8 +89,10 @@ pub struct Sender {
     history: VecDeque<(u64, Vec<u8>)>,
     /// The numbered line awaiting its `ok`.
     in_flight: Option<u64>,
-    /// A resend asked for: the line to send at the next `ok` (or timeout).
+    /// A resend asked for: the line to send at the next `ok` (or after the grace period), and
+    /// when it was asked for.
     resend_from: Option<u64>,
+    resend_asked_at: Option<Instant>,
     last_resend: Option<(u64, u32)>,
     /// Highest line number acknowledged.
     acked: u64,
@@ -107,6 +116,7 @@ impl Sender {
             history: VecDeque::new(),
             in_flight: None,
             resend_from: None,
+            resend_asked_at: None,
             last_resend: None,
             acked: 0,
             probes: 0,
@@ -188,6 +198,7 @@ impl Sender {
     /// The line after `n` has been acknowledged: the next resend, or the next job line.
     fn advance(&mut self) {
         if let Some(r) = self.resend_from.take() {
+            self.resend_asked_at = None;
             let last_sent = self.history.back().map_or(0, |(k, _)| *k);
             if r < last_sent {
                 self.resend_from = Some(r + 1);
@@ -213,7 +224,9 @@ impl Sender {
 
     fn acknowledge(&mut self) {
         if let Some(n) = self.in_flight {
-            if n > self.acked || (n == 0 && self.state == State::Connecting) {
+            // The `ok` after a `Resend` only says "go on": the line in flight was not taken.
+            let resend_pending = self.resend_asked_at.is_some();
+            if !resend_pending && n > self.acked || (n == 0 && self.state == State::Connecting) {
                 self.acked = self.acked.max(n);
                 if n > 0 {
                     self.events.push_back(Event::Progress {
@@ -273,10 +286,15 @@ impl Sender {
                     ));
                     return;
                 }
-                // Sent at the printer's `ok` that follows (or at the timeout if it never comes).
+                // Sent at the printer's `ok` that follows (or after the grace period if it
+                // never comes).
                 self.resend_from = Some(n);
+                self.resend_asked_at = Some(now);
             }
             Reply::Busy => self.seen_busy = true,
+            Reply::Wait | Reply::Duplicate => {}
+            Reply::Error(m) => self.events.push_back(Event::PrinterError(m)),
+            Reply::Action(action) => self.host_action(action),
             Reply::Start => {
                 if self.state != State::Connecting {
                     let at = self.done();
@@ -293,6 +311,38 @@ impl Sender {
         }
     }
 
+    /// What the printer's own screen or buttons ask of the host (OctoPrint's action commands).
+    fn host_action(&mut self, action: HostAction) {
+        match action {
+            HostAction::Pause => {
+                self.events
+                    .push_back(Event::Message("paused on the printer".into()));
+                self.pause();
+            }
+            HostAction::Resume => {
+                self.events
+                    .push_back(Event::Message("resumed on the printer".into()));
+                self.resume();
+            }
+            HostAction::Cancel => {
+                if !self.is_over() {
+                    self.state = State::Cancelled;
+                    self.events.push_back(Event::Failed(format!(
+                        "cancelled on the printer after line {} of {}",
+                        self.done(),
+                        self.cmds.len()
+                    )));
+                }
+            }
+            HostAction::Disconnect => {
+                self.fail("the printer asked the host to disconnect".into());
+            }
+            HostAction::Other(what) => self
+                .events
+                .push_back(Event::Message(format!("the printer says: {what}"))),
+        }
+    }
+
     /// The port failed (unplugged, closed): the job ends with this reason.
     pub fn receive_port_error(&mut self, why: &str) {
         self.fail(why.to_string());
@@ -301,6 +351,16 @@ impl Sender {
     /// The clock: after a silence, probe with `M105`; after too many, give up.
     pub fn tick(&mut self, now: Instant) {
         if self.is_over() || self.in_flight.is_none() {
+            return;
+        }
+        if let (Some(r), Some(at)) = (self.resend_from, self.resend_asked_at)
+            && now.duration_since(at) >= self.cfg.resend_ok_grace
+        {
+            // A Resend without its ok (Smoothieware's `rs N`): act on it.
+            self.resend_from = None;
+            self.resend_asked_at = None;
+            self.last_heard = now;
+            self.resend(r);
             return;
         }
         let limit = if self.seen_busy {
@@ -314,6 +374,7 @@ impl Sender {
         self.last_heard = now;
         if let Some(r) = self.resend_from.take() {
             // A Resend without its ok: act on it.
+            self.resend_asked_at = None;
             self.resend(r);
             return;
         }
@@ -528,5 +589,131 @@ mod tests {
         let (mut s, _) = start(4);
         s.cancel();
         assert_eq!(s.state(), &State::Cancelled);
+    }
+
+    fn line(n: u64, cmd: &str) -> String {
+        String::from_utf8(numbered(n, cmd))
+            .unwrap()
+            .trim_end()
+            .to_string()
+    }
+
+    #[test]
+    fn an_unknown_error_is_shown_and_the_job_goes_on() {
+        for error in [
+            "Error: G0/G1: insufficient axes homed",
+            "!! Move out of range: 250.000 10.000 0.200 [0.000]",
+            "Error:Printer set into dry run mode until restart!",
+            "Error:something no firmware here says",
+        ] {
+            let (mut s, t) = start(3);
+            out(&mut s);
+            s.receive(error, t);
+            assert_eq!(s.state(), &State::Printing, "{error}");
+            assert!(out(&mut s).is_empty(), "wait for the printer's next ok");
+            s.receive("ok", t);
+            assert_eq!(out(&mut s), vec![line(2, "G1 X1")], "{error}");
+            let ev: Vec<Event> = s.events().collect();
+            assert!(
+                ev.contains(&Event::PrinterError(error.trim().into())),
+                "{error}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_unknown_error_without_ok_runs_into_the_silence_timeout() {
+        let (mut s, t) = start(3);
+        out(&mut s);
+        s.receive("Error:Something odd", t);
+        for k in 1..=6 {
+            s.tick(t + Duration::from_secs(11 * k));
+        }
+        assert!(matches!(s.state(), State::Failed(m) if m.contains("no reply")));
+    }
+
+    #[test]
+    fn octoprints_virtual_printer_missing_checksum_is_recovered() {
+        // Its simulated error at line 100: `Error: Missing checksum`, `Resend:N`, `ok`.
+        let (mut s, t) = start(3);
+        s.receive("ok", t); // line 1 acked, 2 sent
+        out(&mut s);
+        s.receive("Error: Missing checksum", t);
+        s.receive("Resend:2", t);
+        s.receive("ok", t);
+        assert_eq!(s.state(), &State::Printing);
+        assert_eq!(out(&mut s), vec![line(2, "G1 X1")]);
+        assert_eq!(s.done(), 1, "the ok after a Resend is no acknowledgement");
+        s.receive("ok", t);
+        assert_eq!(s.done(), 2);
+        assert_eq!(out(&mut s), vec![line(3, "G1 X2")]);
+    }
+
+    #[test]
+    fn a_resend_without_ok_is_acted_on_after_the_grace_period() {
+        // Smoothieware: `rs N2` and nothing else.
+        let (mut s, t) = start(3);
+        s.receive("ok", t);
+        out(&mut s);
+        s.receive("rs N2", t);
+        s.tick(t + Duration::from_millis(100));
+        assert!(out(&mut s).is_empty(), "still in the grace period");
+        s.tick(t + Duration::from_millis(600));
+        assert_eq!(out(&mut s), vec![line(2, "G1 X1")]);
+        s.receive("ok", t + Duration::from_millis(700));
+        assert_eq!(s.done(), 2);
+        assert_eq!(out(&mut s), vec![line(3, "G1 X2")]);
+    }
+
+    #[test]
+    fn known_fatal_messages_of_each_firmware_end_the_job() {
+        for fatal in [
+            "Error:Printer halted. kill() called!",
+            "Error:Thermal Runaway, system stopped! Heater_ID: 0",
+            "Error:MAXTEMP triggered, system stopped! Heater_ID: 0",
+            "Error:: Extruder switched off. MINTEMP triggered !",
+            "!! Shutdown due to M112 command",
+            "// Klipper state: Shutdown",
+            "Emergency Stop! Reset the controller to continue.",
+            "fatal:Heater/sensor error - Printer stopped and heaters disabled due to this error. Fix error and restart with M999.",
+            "!!",
+            "ALARM: Kill button pressed - reset or M999 to continue",
+        ] {
+            let (mut s, t) = start(3);
+            s.receive(fatal, t);
+            assert!(
+                matches!(s.state(), State::Failed(m) if m.contains(fatal.trim())),
+                "{fatal}: {:?}",
+                s.state()
+            );
+        }
+    }
+
+    #[test]
+    fn host_actions_from_the_printers_screen() {
+        let (mut s, t) = start(4);
+        out(&mut s);
+        s.receive("//action:pause", t);
+        s.receive("ok", t);
+        assert!(out(&mut s).is_empty(), "paused from the printer");
+        s.receive("//action:resume", t);
+        assert_eq!(out(&mut s), vec![line(2, "G1 X1")]);
+        s.receive("//action:cancel", t);
+        assert_eq!(s.state(), &State::Cancelled);
+        let (mut s, t) = start(4);
+        s.receive("//action:disconnect", t);
+        assert!(matches!(s.state(), State::Failed(m) if m.contains("disconnect")));
+    }
+
+    #[test]
+    fn keep_alives_are_no_acknowledgements() {
+        let (mut s, t) = start(3);
+        out(&mut s);
+        for keep_alive in ["wait", "echo:busy processing", "busy:processing", "skip 1"] {
+            s.receive(keep_alive, t);
+        }
+        assert_eq!(s.done(), 0);
+        assert!(out(&mut s).is_empty());
+        assert!(s.events().all(|e| !matches!(e, Event::Message(_))));
     }
 }

@@ -167,6 +167,14 @@ fn pump_link_events(
                     panel.messages.pop_front();
                 }
             }
+            LinkEvent::Event(Event::PrinterError(m)) => {
+                panel
+                    .messages
+                    .push_back(format!("printer error (the job goes on): {m}"));
+                while panel.messages.len() > 200 {
+                    panel.messages.pop_front();
+                }
+            }
             LinkEvent::Event(_) => {}
             LinkEvent::Ended(r) => {
                 panel.status = Some(match r {
