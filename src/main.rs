@@ -267,8 +267,13 @@ fn check(path: &Path, design: Option<&Path>) -> Result<ExitCode, Failure> {
             Limits::from(&load_design(d)?.design.printer),
             format!("design {}", d.display()),
         ),
-        None => match Limits::from_header(&text) {
-            Some(l) => (l, "the file's header".to_string()),
+        None => match Limits::from_header(&text).map_err(|e| {
+            Failure(format!(
+                "{file}:{}: clayloft-limits header: {e}",
+                e.line.unwrap_or(1)
+            ))
+        })? {
+            Some((l, _)) => (l, "the file's header".to_string()),
             None => (
                 Limits::from(&clayloft_core::design::Printer::default()),
                 "the paper's printer (defaults)".to_string(),

@@ -282,6 +282,28 @@ fn bad_design(design: &[u8], needles: &[&str]) {
     );
 }
 
+/// Designs whose numbers would make a path too large for any machine: one-line errors, quickly.
+#[test]
+fn absurd_sizes_are_bad_input_not_an_exhausted_machine() {
+    bad_design(
+        format!("[printer]\nmin_layer_height = 0.000001\nlayer_height = 0.5\n{GOOD}")
+            .replace("version = 1\n", "")
+            .replace("[printer]", "version = 1\n[printer]")
+            .as_bytes(),
+        &["printer.min_layer_height", "outside"],
+    );
+    bad_design(
+        "version = 1\n[printer]\nmax_z = 5000\nbed_x = 5000\nbed_y = 5000\n[shape]\nheight = 4000.0\nsamples = 100000\n[shape.lower]\ntype = \"circle\"\nradius = 40.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n"
+            .as_bytes(),
+        &["shape.samples", "wall points"],
+    );
+    bad_design(
+        "version = 1\n[printer]\nbed_x = 9000\nbed_y = 9000\nline_width = 0.1\nnozzle_diameter = 0.1\n[shape]\nheight = 60.0\nsamples = 2000\n[shape.lower]\ntype = \"circle\"\nradius = 4000.0\n[shape.upper]\ntype = \"circle\"\nradius = 4000.0\n"
+            .as_bytes(),
+        &["shape.base_layers", "rings"],
+    );
+}
+
 #[test]
 fn bad_design_files() {
     bad_design(
@@ -401,6 +423,42 @@ fn check_rejects_files_that_are_not_gcode() {
         &clayloft(&["check", empty.to_str().unwrap()]),
         &["no moves"],
     );
+}
+
+/// Hostile numbers: violations (exit 1) or bad input (exit 2), never a hang.
+#[test]
+fn check_is_bounded_whatever_the_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let far = dir.path().join("far.gcode");
+    std::fs::write(
+        &far,
+        "M83\nG1 X10 Y10 Z1 E1\nG1 X1000000000 Y10 Z1 E1\nG1 X10 Y20 Z1 E1\n",
+    )
+    .unwrap();
+    let out = clayloft(&["check", far.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("VIOLATION outside the machine"));
+    let tiny = dir.path().join("tiny.gcode");
+    std::fs::write(
+        &tiny,
+        "; made by hand\n; clayloft-limits: bed_x=180 line_width=0.000001\nG1 X10 Y10 Z1 E1\n",
+    )
+    .unwrap();
+    assert_bad_input(
+        &clayloft(&["check", tiny.to_str().unwrap()]),
+        &["tiny.gcode:2:", "line_width=0.000001", "outside"],
+    );
+    let inf = dir.path().join("inf.gcode");
+    std::fs::write(&inf, "G1 X10 Y10 Z1 E1\nG1 Xinf Y10 Z1 E1\n").unwrap();
+    assert_bad_input(
+        &clayloft(&["check", inf.to_str().unwrap()]),
+        &["inf.gcode", "line 2", "not finite"],
+    );
+    let long = dir.path().join("long.gcode");
+    std::fs::write(&long, format!("G1 X{}q\n", "7".repeat(5_000_000))).unwrap();
+    let out = clayloft(&["check", long.to_str().unwrap()]);
+    assert_bad_input(&out, &["long.gcode", "line 1", "is not a number"]);
+    assert!(out.stderr.len() < 300);
 }
 
 #[test]

@@ -57,7 +57,7 @@ pub fn correct_shape(design: &Design, sections: &mut [Section], from: usize) -> 
 /// Builds the corrected, textured surface of a design.
 pub fn build_surface(design: &Design) -> Result<Surface, FieldError> {
     let loft = LoftInput::from_design(design)?;
-    let (model, findings) = ShapeModel::new(design, loft);
+    let (model, findings) = ShapeModel::new(design, loft)?;
     let sections: Vec<Section> = (0..=model.layers).map(|k| model.section(k)).collect();
     finish_surface(design, &model, sections, findings)
 }

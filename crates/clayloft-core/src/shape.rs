@@ -14,6 +14,7 @@ use crate::geometry::outward_normals;
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind};
 use crate::section::Section;
+use crate::validate::{FieldError, MAX_PATH_POINTS};
 
 /// Safety margin on printer limits: the pipeline aims 2 % inside them so that rounding in the
 /// spiral and the G-code never tips a measurement over.
@@ -40,7 +41,8 @@ pub struct ShapeModel {
 
 impl ShapeModel {
     /// Builds the model and plans the layers; returns findings for any horizontal-line scaling.
-    pub fn new(design: &Design, loft: LoftInput) -> (ShapeModel, Vec<Finding>) {
+    /// A plan with more than [`MAX_PATH_POINTS`] wall points is an error on `shape.samples`.
+    pub fn new(design: &Design, loft: LoftInput) -> Result<(ShapeModel, Vec<Finding>), FieldError> {
         let vertical: Vec<_> = design
             .control
             .vertical
@@ -68,7 +70,18 @@ impl ShapeModel {
             height: design.shape.height,
         };
         let findings = model.plan_layers(design);
-        (model, findings)
+        let points = (model.layers as u128 + 1) * model.loft.samples() as u128;
+        if points > MAX_PATH_POINTS as u128 {
+            return Err(FieldError::new(
+                "shape.samples",
+                format!(
+                    "{} samples × {} layers make {points} wall points, more than the {MAX_PATH_POINTS} a path may have (fewer samples or thicker layers)",
+                    model.loft.samples(),
+                    model.layers + 1
+                ),
+            ));
+        }
+        Ok((model, findings))
     }
 
     /// z offset of sample i at height fraction t from all horizontal lines (scaled).

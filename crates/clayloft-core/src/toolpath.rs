@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3};
 use crate::design::Design;
 use crate::pipeline::Surface;
 use crate::section::Section;
-use crate::validate::FieldError;
+use crate::validate::{FieldError, MAX_PATH_POINTS};
 
 /// Points closer than this in XY (mm) are merged, so that no segment extrudes a vanishing amount.
 const MIN_SEGMENT: f64 = 0.01;
@@ -108,6 +108,18 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
         .map(|q| q.truncate().distance(surface.center))
         .fold(0.0, f64::max);
     let rings = BaseRings::new(r_max, p.line_width);
+    let base_points = base as u128 * (rings.turns as u128 + 1) * n as u128;
+    let wall_points = (layers as u128 + 2) * (n as u128 + 1);
+    if base_points + wall_points > MAX_PATH_POINTS as u128 {
+        return Err(FieldError::new(
+            "shape.base_layers",
+            format!(
+                "{base} base layers of {} rings of {n} points and the wall make {} points, more than the {MAX_PATH_POINTS} a path may have (a wider bead, fewer samples or fewer base layers)",
+                rings.turns,
+                base_points + wall_points
+            ),
+        ));
+    }
     for layer in 1..=base {
         let geometry = base_layer(&sections[layer], surface.center, rings, layer as f64 * h)
             .ok_or_else(|| {

@@ -24,6 +24,10 @@ impl FieldError {
 /// Largest number of samples per section: far beyond any printer's resolution, small enough that
 /// a typo (an extra zero or three) cannot exhaust memory.
 pub const MAX_SAMPLES: usize = 100_000;
+/// Most points a design's path may have (wall sections and spiral base together): 18 times the
+/// 720 × 300 benchmark vessel, a few hundred MB of working memory; beyond it a typo (a layer
+/// height of 0.0001, a huge foot with a fine bead) is an error instead of an exhausted machine.
+pub const MAX_PATH_POINTS: usize = 4_000_000;
 /// Largest size of anything (bed, height, offsets), mm: 10 m.
 const MAX_LENGTH: f64 = 10_000.0;
 
@@ -106,6 +110,20 @@ pub fn validate(d: &Design) -> Check {
     )?;
     positive("printer.min_layer_height", p.min_layer_height, "mm")?;
     positive("printer.max_layer_height", p.max_layer_height, "mm")?;
+    in_range(
+        "printer.min_layer_height",
+        p.min_layer_height,
+        0.01,
+        50.0,
+        "a layer of clay in mm",
+    )?;
+    in_range(
+        "printer.max_layer_height",
+        p.max_layer_height,
+        0.01,
+        50.0,
+        "a layer of clay in mm",
+    )?;
     if p.max_layer_height < p.min_layer_height {
         return Err(FieldError::new(
             "printer.max_layer_height",

@@ -401,7 +401,10 @@ mod tests {
         let text = std::fs::read_to_string(&g).unwrap();
         let report = clayloft_core::check::check_gcode(
             &text,
-            &clayloft_core::check::Limits::from_header(&text).unwrap(),
+            &clayloft_core::check::Limits::from_header(&text)
+                .unwrap()
+                .unwrap()
+                .0,
         )
         .unwrap();
         assert!(report.ok(), "{report}");

@@ -109,7 +109,9 @@ width = 60.0
     }
 
     fn model(d: &Design) -> ShapeModel {
-        ShapeModel::new(d, LoftInput::from_design(d).unwrap()).0
+        ShapeModel::new(d, LoftInput::from_design(d).unwrap())
+            .unwrap()
+            .0
     }
 
     #[test]

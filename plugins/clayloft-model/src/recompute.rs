@@ -140,8 +140,13 @@ pub fn recompute_model(
                     sample_of(ContourRole::Upper),
                     center,
                 );
-                let (m, f) = ShapeModel::new(design, loft);
-                (m, f, None)
+                match ShapeModel::new(design, loft) {
+                    Ok((m, f)) => (m, f, None),
+                    Err(e) => {
+                        status.error = Some(e.to_string());
+                        return;
+                    }
+                }
             }
         };
     // Stage 3: sections, one entity per section; only the dirty ones are reshaped.

@@ -1,0 +1,361 @@
+//! The G-code checker (SPEC §2, §7): re-measures a G-code file alone against the printer's limits.
+//!
+//! * Single continuous path: between the first and the last extruding move every move extrudes;
+//!   no retraction anywhere.
+//! * Inside the machine: every move's end point on the bed and within 0 ..= max_z.
+//! * Layer height and overhang: for each path vertex p, the layer below is the topmost earlier
+//!   path (more than a few line widths back along the path, at least a quarter of the minimum
+//!   layer height lower) within a search radius in XY. Local layer height = p.z − z below; the lean
+//!   is `atan(d / height)` with d the XY distance to that layer. Points low enough rest on the bed.
+//! * Collision: the highest earlier printed point may rise at most `nozzle_length` above the
+//!   nozzle tip (the holder is treated as a plane `nozzle_length` above the tip).
+
+mod layers;
+mod limits;
+mod moves;
+mod report;
+
+use glam::DVec3;
+
+pub use limits::{Limits, LimitsError};
+pub use moves::{GcodeError, Move, parse_moves};
+use report::Tally;
+pub use report::{
+    COLLISION, CheckReport, NOT_MEASURED, OVERHANG, PathEvent, UNSUPPORTED, Violation,
+};
+
+/// Re-measures a G-code program against `limits`. Errors only when the text is not G-code.
+pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeError> {
+    limits.validate().map_err(|e| GcodeError {
+        line: e.line.unwrap_or(1),
+        message: format!("limits: {e}"),
+    })?;
+    let (moves, start) = parse_moves(text)?;
+    if moves.is_empty() {
+        return Err(GcodeError {
+            line: 1,
+            message: "there are no moves to check".into(),
+        });
+    }
+    let mut report = CheckReport {
+        moves: moves.len(),
+        ..Default::default()
+    };
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    let (mut outside, mut travel, mut retract) =
+        (Tally::default(), Tally::default(), Tally::default());
+    let first_ext = moves.iter().position(|m| m.de > 0.0);
+    let last_ext = moves.iter().rposition(|m| m.de > 0.0);
+    let mut prev = start;
+    for (k, m) in moves.iter().enumerate() {
+        if m.de > 0.0 {
+            lo = lo.min(m.to);
+            hi = hi.max(m.to);
+        }
+        let eps = 1e-6;
+        if m.to.x < -eps
+            || m.to.y < -eps
+            || m.to.x > limits.bed_x + eps
+            || m.to.y > limits.bed_y + eps
+            || m.to.z < -eps
+            || m.to.z > limits.max_z + eps
+        {
+            outside.add(0.0, m.line);
+        }
+        if m.de < 0.0 {
+            retract.add(-m.de, m.line);
+        }
+        if let (Some(a), Some(b)) = (first_ext, last_ext)
+            && k > a
+            && k <= b
+            && m.de <= 0.0
+            && m.to != prev
+        {
+            travel.add(m.to.distance(prev), m.line);
+        }
+        prev = m.to;
+    }
+    if lo.is_finite() {
+        report.bounds_min = lo;
+        report.bounds_max = hi;
+    }
+    report.violations.extend(
+        [
+            outside.into_violation(
+                "outside the machine",
+                format!("bed 0 … {} × 0 … {} mm, height 0 … {} mm", limits.bed_x, limits.bed_y, limits.max_z),
+            ),
+            travel.into_violation(
+                "not one continuous path",
+                "moves without extrusion between the first and last extruding move (worst = longest, mm)".into(),
+            ),
+            retract.into_violation("retraction", "clay printing allows no retraction (worst = mm of E)".into()),
+        ]
+        .into_iter()
+        .flatten(),
+    );
+    if let (Some(a), Some(b)) = (first_ext, last_ext) {
+        let mut vertices = Vec::with_capacity(b - a + 2);
+        let mut lines = Vec::with_capacity(b - a + 2);
+        vertices.push(if a == 0 { start } else { moves[a - 1].to });
+        lines.push(moves[a].line);
+        for m in &moves[a..=b] {
+            vertices.push(m.to);
+            lines.push(m.line);
+        }
+        report.extruding_moves = moves[a..=b].iter().filter(|m| m.de > 0.0).count();
+        layers::measure_layers(&vertices, &lines, limits, &mut report);
+    }
+    Ok(report)
+}
+
+/// Measures an extruding path (layer heights, overhang, support, holder collision) given as
+/// points; the `line` of each event and violation is the point index. The app's nozzle replay
+/// uses this on the toolpath so that it flags exactly what `clayloft check` would.
+pub fn check_path(points: &[DVec3], limits: &Limits) -> CheckReport {
+    let mut report = CheckReport {
+        moves: points.len(),
+        extruding_moves: points.len().saturating_sub(1),
+        ..Default::default()
+    };
+    if let Err(e) = limits.validate() {
+        report.violations.push(Violation {
+            what: NOT_MEASURED,
+            count: 1,
+            worst: 0.0,
+            first_line: 0,
+            detail: format!("limits: {e}"),
+        });
+        return report;
+    }
+    if points.len() >= 2 {
+        let lines: Vec<usize> = (0..points.len()).collect();
+        layers::measure_layers(points, &lines, limits, &mut report);
+    }
+    report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::Printer;
+
+    fn limits() -> Limits {
+        Limits::from(&Printer::default())
+    }
+
+    fn helix(radius_per_layer: f64, layers: usize, h: f64) -> String {
+        let mut s = String::from("G21\nG90\nM83\nG0 X120 Y95 Z1\n");
+        let n = 100;
+        for k in 0..layers * n {
+            let t = (k + 1) as f64 / n as f64;
+            let a = std::f64::consts::TAU * t;
+            let r = 30.0 + radius_per_layer * t;
+            // Flat first revolution, then a helix that leaves it by the minimum layer height.
+            let z = if k < n {
+                h
+            } else if t <= 2.0 {
+                h + 0.25 + (h - 0.25) * (t - 1.0)
+            } else {
+                h * t
+            };
+            s += &format!(
+                "G1 X{:.3} Y{:.3} Z{:.3} E0.5\n",
+                90.0 + r * a.cos(),
+                95.0 + r * a.sin(),
+                z
+            );
+        }
+        s
+    }
+
+    #[test]
+    fn check_path_flags_each_point_like_the_gcode_checker() {
+        let text = helix(1.5, 10, 1.0);
+        let from_gcode = check_gcode(&text, &limits()).unwrap();
+        let (moves, start) = parse_moves(&text).unwrap();
+        let points: Vec<DVec3> = std::iter::once(start)
+            .chain(moves.iter().map(|m| m.to))
+            .collect();
+        let r = check_path(&points[1..], &limits());
+        let lean = |r: &CheckReport| {
+            r.violations
+                .iter()
+                .find(|v| v.what == OVERHANG)
+                .map(|v| v.count)
+        };
+        assert!(lean(&r).unwrap() > 0);
+        assert_eq!(lean(&r), lean(&from_gcode));
+        let overhangs: Vec<&PathEvent> = r.events.iter().filter(|e| e.what == OVERHANG).collect();
+        assert_eq!(overhangs.len(), lean(&r).unwrap());
+        assert!(overhangs.windows(2).all(|w| w[0].line < w[1].line));
+        assert!(overhangs.iter().all(|e| e.value > 45.0));
+        // A point far below a tall printed part is a holder collision at that index.
+        let mut tower: Vec<DVec3> = (0..200)
+            .map(|k| {
+                DVec3::new(
+                    90.0 + 30.0 * (k as f64 * 0.1).cos(),
+                    95.0 + 30.0 * (k as f64 * 0.1).sin(),
+                    1.0 + k as f64 * 0.2,
+                )
+            })
+            .collect();
+        tower.push(DVec3::new(90.0, 95.0, 1.0));
+        let r = check_path(&tower, &limits());
+        let hit: Vec<&PathEvent> = r.events.iter().filter(|e| e.what == COLLISION).collect();
+        assert_eq!(hit.len(), 1);
+        assert_eq!(hit[0].line, 200);
+        assert!((hit[0].value - 39.8).abs() < 1e-9);
+    }
+
+    #[test]
+    fn vertical_spiral_passes() {
+        let r = check_gcode(&helix(0.0, 10, 1.0), &limits()).unwrap();
+        assert!(r.ok(), "{r}");
+        assert!(r.max_overhang_deg < 1.0, "{}", r.max_overhang_deg);
+        assert!((r.max_layer_height - 1.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn flare_past_45_is_an_overhang() {
+        let r = check_gcode(&helix(1.5, 10, 1.0), &limits()).unwrap();
+        let v = r
+            .violations
+            .iter()
+            .find(|v| v.what == "overhang")
+            .expect("overhang found");
+        // 1.5 mm outward per 1 mm layer is 56°; steeper where the helix leaves the flat revolution.
+        assert!(v.worst >= 56.0, "{}", v.worst);
+        assert!(v.count > 500, "{}", v.count);
+        // 0.8 mm per layer in the steady helix is 38.7°: only the thin helix start breaks 45°.
+        let mild = check_gcode(&helix(0.8, 10, 1.0), &limits()).unwrap();
+        assert!(mild.violations.iter().all(|v| v.count < 200), "{mild}");
+    }
+
+    #[test]
+    fn travel_and_retraction_break_continuity() {
+        let g = "M83\nG1 X10 Y10 Z1 E1\nG1 X20 Y10 Z1 E1\nG0 X30 Y10\nG1 X40 Y10 Z1 E-1\nG1 X50 Y10 Z1 E1\n";
+        let r = check_gcode(g, &limits()).unwrap();
+        let kinds: Vec<_> = r.violations.iter().map(|v| v.what).collect();
+        assert!(kinds.contains(&"not one continuous path"), "{kinds:?}");
+        assert!(kinds.contains(&"retraction"), "{kinds:?}");
+    }
+
+    #[test]
+    fn off_the_bed_and_too_high() {
+        let r = check_gcode("G1 X500 Y10 Z1 E1\nG1 X10 Y10 Z900 E1\n", &limits()).unwrap();
+        assert_eq!(r.violations[0].what, "outside the machine");
+        assert_eq!(r.violations[0].count, 2);
+    }
+
+    #[test]
+    fn absolute_extrusion_and_header_limits() {
+        let g = "; clayloft-limits: bed_x=50 bed_y=50 max_z=20\nM82\nG1 X10 Y10 Z1 E1\nG1 X20 Y10 Z1 E2\nG1 X30 Y10 Z1 E3\n";
+        let (l, _) = Limits::from_header(g).unwrap().unwrap();
+        assert_eq!((l.bed_x, l.max_z, l.line_width), (50.0, 20.0, 3.0));
+        let r = check_gcode(g, &l).unwrap();
+        assert!(r.ok(), "{r}");
+        assert_eq!(r.extruding_moves, 3);
+    }
+
+    #[test]
+    fn line_numbers_and_checksums_are_understood() {
+        let (moves, _) = parse_moves("N1 G1 X10 Y10 Z1 E1*37\nN2 G1 X20 Y10 Z1 E1*38\n").unwrap();
+        assert_eq!(moves.len(), 2);
+        assert_eq!(moves[1].to, DVec3::new(20.0, 10.0, 1.0));
+    }
+
+    #[test]
+    fn garbage_is_an_error_with_a_line() {
+        let e = check_gcode("G1 X10\nhello world\n", &limits()).unwrap_err();
+        assert_eq!(e.line, 2);
+        let e = check_gcode("G1 Xabc\n", &limits()).unwrap_err();
+        assert!(e.message.contains("Xabc"));
+        assert!(check_gcode("; nothing\n", &limits()).is_err());
+    }
+
+    /// Hostile files end quickly with violations or an error, whatever their numbers.
+    #[test]
+    fn hostile_numbers_are_violations_or_errors_never_a_hang() {
+        // The four-line file that once ran for minutes: a coordinate of 1e9.
+        let r = check_gcode(
+            "M83\nG1 X10 Y10 Z1 E1\nG1 X1000000000 Y10 Z1 E1\nG1 X10 Y20 Z1 E1\n",
+            &limits(),
+        )
+        .unwrap();
+        assert!(
+            r.violations.iter().any(|v| v.what == "outside the machine"),
+            "{r}"
+        );
+        // Diagonals across a 10 m bed with the finest bead: too many cells for the budget.
+        let mut big = String::from(
+            "; clayloft-limits: bed_x=10000 bed_y=10000 max_z=10000 line_width=0.1 min_layer_height=0.01 max_layer_height=0.01\nM83\n",
+        );
+        for k in 0..2000 {
+            let (x, y) = if k % 2 == 0 { (0, 0) } else { (10000, 10000) };
+            big += &format!("G1 X{x} Y{y} Z{:.2} E1\n", 0.01 * (k / 2) as f64);
+        }
+        let (l, _) = Limits::from_header(&big).unwrap().unwrap();
+        let r = check_gcode(&big, &l).unwrap();
+        assert!(r.violations.iter().any(|v| v.what == NOT_MEASURED), "{r}");
+        // A file that zig-zags on one spot, slowly rising: every chord in the same few cells,
+        // every point searching all of them.
+        let mut spot = String::from("M83\n");
+        let n = 100_000;
+        for k in 0..n {
+            spot += &format!(
+                "G1 X{:.3} Y90 Z{:.5} E0.01\n",
+                90.0 + 0.5 * (k % 2) as f64,
+                1.0 + k as f64 / n as f64
+            );
+        }
+        let r = check_gcode(&spot, &limits()).unwrap();
+        assert!(r.violations.iter().any(|v| v.what == NOT_MEASURED), "{r}");
+        // Relative moves that run past every finite number.
+        let e = check_gcode("G91\nG1 X1e308 E1\nG1 X1e308 E1\n", &limits()).unwrap_err();
+        assert!(e.message.contains("finite"), "{e}");
+        // An absurd line: its word is quoted short.
+        let long = format!("G1 X{}abc\n", "9".repeat(1_000_000));
+        let e = check_gcode(&long, &limits()).unwrap_err();
+        assert!(e.message.len() < 200, "{}", e.message.len());
+        // Microscopic or absurd limits are refused, never used.
+        let tiny = Limits {
+            line_width: 1e-9,
+            ..limits()
+        };
+        assert!(
+            check_gcode("G1 X1 E1\n", &tiny)
+                .unwrap_err()
+                .message
+                .contains("line_width")
+        );
+        let r = check_path(&[DVec3::ZERO, DVec3::X], &tiny);
+        assert_eq!(r.violations[0].what, NOT_MEASURED);
+    }
+
+    #[test]
+    fn chords_stand_for_nearly_collinear_runs() {
+        // A finely sampled circle: chords about a millimetre long, whatever the sampling.
+        let n = 20_000;
+        let circle: Vec<DVec3> = (0..=n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                DVec3::new(50.0 * a.cos(), 50.0 * a.sin(), 1.0)
+            })
+            .collect();
+        let c = layers::chords(&circle);
+        assert!(c.len() < n / 10, "{}", c.len());
+        assert_eq!(c.first().unwrap().0, 0);
+        assert_eq!(c.last().unwrap().1, n);
+        assert!(c.windows(2).all(|w| w[0].1 == w[1].0));
+        // A square's corners are kept.
+        let square = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(5.0, 0.0, 0.0),
+            DVec3::new(10.0, 0.0, 0.0),
+            DVec3::new(10.0, 10.0, 0.0),
+        ];
+        assert_eq!(layers::chords(&square), vec![(0, 2), (2, 3)]);
+    }
+}

@@ -1,0 +1,130 @@
+//! What the checker measured and which limits were broken, and how that reads.
+
+use std::fmt;
+
+use glam::DVec3;
+
+/// One kind of limit broken, with how often, how badly and where first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Violation {
+    pub what: &'static str,
+    pub count: usize,
+    pub worst: f64,
+    pub first_line: usize,
+    pub detail: String,
+}
+
+/// What the checker measured.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CheckReport {
+    pub moves: usize,
+    pub extruding_moves: usize,
+    pub path_length_mm: f64,
+    pub max_overhang_deg: f64,
+    pub min_layer_height: f64,
+    pub max_layer_height: f64,
+    /// Largest height of already printed material above the nozzle tip, mm.
+    pub max_rise_above_tip: f64,
+    pub bounds_min: DVec3,
+    pub bounds_max: DVec3,
+    pub violations: Vec<Violation>,
+    /// Every point that broke the overhang, support or collision limit, in path order.
+    pub events: Vec<PathEvent>,
+}
+
+/// One point of the path that broke a limit: where (G-code line, or point index for
+/// [`check_path`]), which limit and by how much (degrees or mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathEvent {
+    pub line: usize,
+    pub what: &'static str,
+    pub value: f64,
+}
+
+/// What the nozzle holder hitting the printed part is called in reports.
+pub const COLLISION: &str = "nozzle collision";
+/// What a point leaning past the overhang limit is called in reports.
+pub const OVERHANG: &str = "overhang";
+/// What a point with nothing under it is called in reports.
+pub const UNSUPPORTED: &str = "unsupported";
+/// What a path the layer search could not measure within its budget is called in reports.
+pub const NOT_MEASURED: &str = "not measurable";
+
+impl CheckReport {
+    pub fn ok(&self) -> bool {
+        self.violations.is_empty()
+    }
+}
+
+impl fmt::Display for CheckReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "moves: {} ({} extruding), path length {:.1} mm",
+            self.moves, self.extruding_moves, self.path_length_mm
+        )?;
+        writeln!(
+            f,
+            "printed extent: x {:.1} … {:.1}, y {:.1} … {:.1}, z {:.2} … {:.2} mm",
+            self.bounds_min.x,
+            self.bounds_max.x,
+            self.bounds_min.y,
+            self.bounds_max.y,
+            self.bounds_min.z,
+            self.bounds_max.z
+        )?;
+        writeln!(f, "max overhang: {:.1}°", self.max_overhang_deg)?;
+        writeln!(
+            f,
+            "layer height: {:.3} … {:.3} mm",
+            self.min_layer_height, self.max_layer_height
+        )?;
+        writeln!(
+            f,
+            "printed part above nozzle tip: up to {:.2} mm",
+            self.max_rise_above_tip
+        )?;
+        if self.ok() {
+            write!(f, "all limits hold")
+        } else {
+            for v in &self.violations {
+                writeln!(
+                    f,
+                    "VIOLATION {}: {} moves, worst {:.3}, first at line {} ({})",
+                    v.what, v.count, v.worst, v.first_line, v.detail
+                )?;
+            }
+            write!(f, "{} limit(s) broken", self.violations.len())
+        }
+    }
+}
+
+/// Collects violations of one kind.
+#[derive(Default)]
+pub(super) struct Tally {
+    count: usize,
+    worst: f64,
+    first_line: usize,
+}
+
+impl Tally {
+    /// The violation this tally records, if any.
+    pub(super) fn into_violation(self, what: &'static str, detail: String) -> Option<Violation> {
+        (self.count > 0).then_some(Violation {
+            what,
+            count: self.count,
+            worst: self.worst,
+            first_line: self.first_line,
+            detail,
+        })
+    }
+
+    pub(super) fn add(&mut self, value: f64, line: usize) {
+        if self.count == 0 {
+            self.first_line = line;
+            self.worst = value;
+        }
+        self.count += 1;
+        self.worst = self.worst.max(value);
+    }
+}
