@@ -282,6 +282,30 @@ fn bad_design(design: &[u8], needles: &[&str]) {
     );
 }
 
+/// Written files get the permissions of any program's new files under the user's umask.
+#[cfg(target_os = "linux")]
+#[test]
+fn written_files_follow_the_umask() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let design = designs()[0].clone();
+    for (umask, want) in [("022", 0o644), ("077", 0o600), ("002", 0o664)] {
+        for (cmd, name) in [("gcode", "out.gcode"), ("stl", "out.stl")] {
+            let out = dir.path().join(format!("{umask}-{name}"));
+            let script = format!("umask {umask} && exec \"$0\" {cmd} \"$1\" -o \"$2\"",);
+            let run = Command::new("sh")
+                .args(["-c", &script, env!("CARGO_BIN_EXE_clayloft")])
+                .arg(&design)
+                .arg(&out)
+                .output()
+                .unwrap();
+            assert!(run.status.success(), "{}", text(&run.stderr));
+            let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+            assert_eq!(mode, want, "{cmd} under umask {umask}: {mode:o}");
+        }
+    }
+}
+
 /// Designs whose numbers would make a path too large for any machine: one-line errors, quickly.
 #[test]
 fn absurd_sizes_are_bad_input_not_an_exhausted_machine() {

@@ -1,6 +1,10 @@
 //! Writing output files all-or-nothing: the data goes to a temporary file in the destination's
 //! folder, which is renamed over the destination only when complete. A failed or interrupted
 //! write never leaves a partial file behind.
+//!
+//! Permissions are those any program's new files get: read/write for all less the user's umask
+//! (0644 under the usual 022), so that a printer host running as another user can read the
+//! G-code. A file that is replaced keeps the permissions it had.
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -33,11 +37,22 @@ pub fn write_atomically(
     if path.is_dir() {
         return Err(err("it is a folder".into()));
     }
-    let tmp = tempfile::Builder::new()
-        .prefix(".clayloft-")
-        .suffix(".part")
-        .tempfile_in(dir)
-        .map_err(|e| err(e.to_string()))?;
+    let existing = std::fs::metadata(path).ok().map(|m| m.permissions());
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".clayloft-").suffix(".part");
+    #[cfg(unix)]
+    {
+        // What `open(2)` makes of mode 0666: the umask applies (the library would otherwise
+        // create its files readable by their owner only).
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let tmp = builder.tempfile_in(dir).map_err(|e| err(e.to_string()))?;
+    if let Some(p) = existing {
+        tmp.as_file()
+            .set_permissions(p)
+            .map_err(|e| err(e.to_string()))?;
+    }
     {
         let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
         fill(&mut w).map_err(|e| err(e.to_string()))?;
@@ -69,6 +84,30 @@ mod tests {
             1,
             "no temporary left"
         );
+    }
+
+    /// The umask of this process, from /proc (Linux).
+    #[cfg(target_os = "linux")]
+    fn umask() -> u32 {
+        let status = std::fs::read_to_string("/proc/self/status").unwrap();
+        let line = status.lines().find(|l| l.starts_with("Umask:")).unwrap();
+        u32::from_str_radix(line["Umask:".len()..].trim(), 8).unwrap()
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn new_files_get_the_umasks_permissions_replaced_files_keep_theirs() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("a.gcode");
+        write_atomically(&out, |w| w.write_all(b"G1 X1")).unwrap();
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o666 & !umask(), "{mode:o}");
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomically(&out, |w| w.write_all(b"G1 X2")).unwrap();
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640);
+        assert_eq!(std::fs::read(&out).unwrap(), b"G1 X2");
     }
 
     #[test]
