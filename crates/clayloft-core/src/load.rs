@@ -66,6 +66,13 @@ pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
     let bytes = std::fs::read(path).map_err(|e| read_err(io_reason(&e)))?;
     let source = String::from_utf8(bytes)
         .map_err(|_| read_err("it is not a text (UTF-8) file — is it a design?".into()))?;
+    load_design_text(path, source)
+}
+
+/// Parses and validates the text of the design file `path` (already read); errors are located
+/// in that text as [`load_design`]'s are.
+pub fn load_design_text(path: &Path, source: String) -> Result<LoadedDesign, DesignError> {
+    let file = path.display().to_string();
     let mut design = parse_design(&source).map_err(|e| match e {
         ParseError::Syntax { line, message } => DesignError::Syntax {
             file: file.clone(),
