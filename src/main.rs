@@ -8,6 +8,7 @@ mod flow;
 mod printer;
 mod screenshot;
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -40,6 +41,10 @@ enum Command {
         design: PathBuf,
         #[arg(short, long)]
         out: PathBuf,
+        /// Printer profile: a shipped name (`clayloft printers`) or a profile file; replaces the
+        /// design's `printer.profile` (fields the design sets itself still win).
+        #[arg(long)]
+        printer: Option<String>,
     },
     /// Export the printed wall (thickness = line width, with the base) as a closed STL mesh.
     Stl {
@@ -49,9 +54,19 @@ enum Command {
         /// Write ASCII STL instead of binary.
         #[arg(long)]
         ascii: bool,
+        /// Printer profile, as for `gcode`.
+        #[arg(long)]
+        printer: Option<String>,
     },
     /// Print what a design makes (layers, path, time, corrections) without opening a window.
-    Info { design: Option<PathBuf> },
+    Info {
+        design: Option<PathBuf>,
+        /// Printer profile, as for `gcode`.
+        #[arg(long)]
+        printer: Option<String>,
+    },
+    /// List the shipped printer profiles (name, bed shape and size, origin, firmware dialect).
+    Printers,
     /// Render the editor's view of a design to a PNG and exit (works under xvfb-run with Mesa).
     Screenshot {
         design: Option<PathBuf>,
@@ -121,8 +136,18 @@ impl<E: std::fmt::Display> From<E> for Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Gcode { design, out }) => gcode(&design, &out),
-        Some(Command::Stl { design, out, ascii }) => stl(&design, &out, ascii),
+        Some(Command::Gcode {
+            design,
+            out,
+            printer,
+        }) => gcode(&design, &out, printer.as_deref()),
+        Some(Command::Stl {
+            design,
+            out,
+            ascii,
+            printer,
+        }) => stl(&design, &out, ascii, printer.as_deref()),
+        Some(Command::Printers) => printers(),
         Some(Command::Check { gcode, design }) => check(&gcode, design.as_deref()),
         Some(Command::Print {
             gcode,
@@ -144,7 +169,9 @@ fn main() -> ExitCode {
             log,
         }),
         Some(Command::Flow(options)) => flow::flow(options),
-        Some(Command::Info { design }) => overview(&design.unwrap_or_else(default_design)),
+        Some(Command::Info { design, printer }) => {
+            overview(&design.unwrap_or_else(default_design), printer.as_deref())
+        }
         Some(Command::Screenshot {
             design,
             out,
@@ -182,10 +209,41 @@ fn default_design() -> PathBuf {
 }
 
 /// Loads a design and runs the pipeline, with errors located in the file.
-fn job_of(path: &Path) -> Result<(LoadedDesign, PrintJob), Failure> {
-    let loaded = load_design(path)?;
+fn job_of(path: &Path, printer: Option<&str>) -> Result<(LoadedDesign, PrintJob), Failure> {
+    let loaded = clayloft_core::load::load_design_using(path, printer)?;
     let job = clayloft_core::run(&loaded.design).map_err(|e| loaded.locate(e))?;
     Ok((loaded, job))
+}
+
+/// `clayloft printers`: the shipped profiles, one line each.
+fn printers() -> Result<ExitCode, Failure> {
+    use clayloft_core::design::{BedShape, Dialect, Origin};
+    println!(
+        "{:<22} {:<40} {:<22} {:<7} {:<15} kinematics",
+        "profile", "printer", "bed", "origin", "firmware"
+    );
+    for (name, text) in clayloft_core::profile::SHIPPED {
+        let file = clayloft_core::profile::parse_shipped(name, text).map_err(Failure)?;
+        let p = file.printer;
+        let bed = match p.bed_shape {
+            BedShape::Rectangle => format!("{} x {} x {} mm", p.bed_x, p.bed_y, p.max_z),
+            BedShape::Circle => format!("round {} x {} mm", p.bed_x, p.max_z),
+        };
+        let origin = match p.origin {
+            Origin::Corner => "corner",
+            Origin::Centre => "centre",
+        };
+        let dialect = match p.dialect {
+            Dialect::Marlin => "marlin",
+            Dialect::Klipper => "klipper",
+            Dialect::RepRapFirmware => "reprapfirmware",
+        };
+        println!(
+            "{name:<22} {:<40} {bed:<22} {origin:<7} {dialect:<15} {:?}",
+            file.name, p.kinematics
+        );
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
@@ -193,6 +251,9 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
     let s = summarize(d, job);
     let m = &job.surface.metrics;
     println!("design: {} ({})", d.name, loaded.path.display());
+    if let Some(profile) = &d.printer.profile {
+        println!("printer: {profile}");
+    }
     println!(
         "layers: {} (pitch {:.3} mm), points: {}, path length: {:.1} mm",
         s.layers, job.surface.layer_pitch, s.points, s.path_length_mm
@@ -221,16 +282,40 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
     }
 }
 
-fn gcode(design: &Path, out: &Path) -> Result<ExitCode, Failure> {
-    let (loaded, job) = job_of(design)?;
-    clayloft_core::atomic::write_atomically(out, |w| write_gcode(&loaded.design, &job, w))?;
+fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
+    let (loaded, job) = job_of(design, printer)?;
+    let mut text = Vec::with_capacity(job.toolpath.points.len() * 40 + 65_536);
+    write_gcode(&loaded.design, &job, &mut text)?;
+    let d = &loaded.design;
+    if d.constraints.enforce {
+        // Right first time: the file is re-measured by the checker before it is written; a
+        // design that still breaks a limit on this printer is refused with what broke.
+        let report = std::str::from_utf8(&text)
+            .map_err(|_| Failure("the G-code writer made non-text".into()))
+            .and_then(|t| check_gcode(t, &Limits::from(&d.printer)).map_err(Failure::from))?;
+        if let Some(v) = report.violations.first() {
+            return Err(Failure(format!(
+                "{}: does not print on this printer ({}): {} at {} points, worst {:.2} ({}); try a printer with a finer bead or thinner layers, or a simpler contour",
+                loaded.path.display(),
+                d.printer
+                    .profile
+                    .as_deref()
+                    .unwrap_or("the paper's printer"),
+                v.what,
+                v.count,
+                v.worst,
+                v.detail
+            )));
+        }
+    }
+    clayloft_core::atomic::write_atomically(out, |w| w.write_all(&text))?;
     print_summary(&loaded, &job);
     println!("wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
 }
 
-fn stl(design: &Path, out: &Path, ascii: bool) -> Result<ExitCode, Failure> {
-    let (loaded, job) = job_of(design)?;
+fn stl(design: &Path, out: &Path, ascii: bool, printer: Option<&str>) -> Result<ExitCode, Failure> {
+    let (loaded, job) = job_of(design, printer)?;
     let d = &loaded.design;
     let mesh = wall_mesh(&job.surface, d.printer.line_width, d.shape.base_layers);
     clayloft_core::atomic::write_atomically(out, |w| {
@@ -291,8 +376,8 @@ fn check(path: &Path, design: Option<&Path>) -> Result<ExitCode, Failure> {
 }
 
 /// `clayloft info [DESIGN]`: what the design would print.
-fn overview(design: &Path) -> Result<ExitCode, Failure> {
-    let (loaded, job) = job_of(design)?;
+fn overview(design: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
+    let (loaded, job) = job_of(design, printer)?;
     print_summary(&loaded, &job);
     Ok(ExitCode::SUCCESS)
 }
@@ -322,7 +407,7 @@ fn shoot(
             "{width} × {height}: the picture must be 64 … 8192 pixels each way"
         )));
     }
-    let (loaded, _job) = job_of(&design)?;
+    let (loaded, _job) = job_of(&design, None)?;
     let req = screenshot::ScreenshotRequest {
         out,
         progress,

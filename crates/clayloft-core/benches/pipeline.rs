@@ -86,6 +86,7 @@ fn gcode_writing(c: &mut Criterion) {
             points,
             base_points: 0,
             revolutions: 1,
+            layer_starts: vec![0],
         },
     };
     let mut buf = Vec::with_capacity(64 << 20);

@@ -90,10 +90,84 @@ pub enum ExtrusionMode {
     Absolute,
 }
 
+/// The shape of the bed (SPEC §12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum BedShape {
+    #[default]
+    Rectangle,
+    /// A round bed of `bed_diameter` (deltas).
+    Circle,
+}
+
+/// Where the printer's (0, 0) is on the bed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Origin {
+    /// The front left corner (most cartesian printers).
+    #[default]
+    #[serde(rename = "corner")]
+    Corner,
+    /// The centre of the bed (deltas, some large-format printers).
+    #[serde(rename = "centre", alias = "center")]
+    Centre,
+}
+
+/// How the printer moves its nozzle; the start/end G-code and the time estimate follow it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Kinematics {
+    #[default]
+    Cartesian,
+    Delta,
+    Scara,
+}
+
+/// The firmware's G-code dialect: the default start and end G-code follow it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Dialect {
+    #[default]
+    Marlin,
+    Klipper,
+    RepRapFirmware,
+}
+
 /// The printer and the print settings. Defaults: the paper's clay printer (Cerambot Plus class).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Printer {
+    /// A printer profile (SPEC §12) these settings start from: the name of a shipped profile
+    /// (`clayloft printers` lists them) or a path to a profile file, relative to the design.
+    /// Fields given here override the profile's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub profile: Option<String>,
+    /// `"rectangle"` (`bed_x` × `bed_y`) or `"circle"` (`bed_diameter`).
+    pub bed_shape: BedShape,
+    /// Diameter of a round bed, mm (with `bed_shape = "circle"`; then `bed_x` = `bed_y` = it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bed_diameter: Option<f64>,
+    /// Where the printer's (0, 0) is: `"corner"` or `"centre"`.
+    pub origin: Origin,
+    pub kinematics: Kinematics,
+    /// `"marlin"`, `"klipper"` or `"reprapfirmware"`: the default start/end G-code.
+    pub dialect: Dialect,
+    /// Acceleration of print moves, mm/s² (the time estimate plans with it).
+    pub max_acceleration: f64,
+    /// Cornering limit as Marlin's junction deviation, mm (Klipper's square corner velocity v
+    /// is the same limit with `junction_deviation = v² (√2 − 1) / max_acceleration`).
+    pub junction_deviation: f64,
+    /// G-code before the path (placeholders in braces, see the README); `None` = the dialect's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start_gcode: Option<String>,
+    /// G-code after the path; `None` = the dialect's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_gcode: Option<String>,
+    /// Header comments that printer hosts read (time, clay used, layers) and layer messages.
+    pub host_metadata: bool,
+    /// `M73` progress (percent and minutes left) through the path.
+    pub progress: bool,
+    /// A small picture of the vessel in the header, for host and printer screens.
+    pub thumbnail: bool,
     /// Bed size along x, mm.
     pub bed_x: f64,
     /// Bed size along y, mm.
@@ -130,6 +204,22 @@ pub struct Printer {
 impl Default for Printer {
     fn default() -> Self {
         Printer {
+            profile: None,
+            bed_shape: BedShape::Rectangle,
+            bed_diameter: None,
+            origin: Origin::Corner,
+            kinematics: Kinematics::Cartesian,
+            dialect: Dialect::Marlin,
+            // A desktop clay printer's print acceleration: Eazao's own Cura definition
+            // (resources/definitions/eazao_zero.def.json, acceleration_print = 300).
+            max_acceleration: 300.0,
+            // Marlin's default JUNCTION_DEVIATION_MM (Configuration.h).
+            junction_deviation: 0.013,
+            start_gcode: None,
+            end_gcode: None,
+            host_metadata: true,
+            progress: true,
+            thumbnail: true,
             bed_x: 180.0,
             bed_y: 190.0,
             max_z: 200.0,
@@ -332,12 +422,51 @@ impl Default for Constraints {
     }
 }
 
+impl Printer {
+    /// A round bed is `bed_diameter` across in x and y.
+    pub fn normalize(&mut self) {
+        if self.bed_shape == BedShape::Circle
+            && let Some(d) = self.bed_diameter
+        {
+            self.bed_x = d;
+            self.bed_y = d;
+        }
+    }
+
+    /// Where the printer's (0, 0) lies in Clayloft's bed frame (x, y from the bed's front left
+    /// corner, 0 … `bed_x`, 0 … `bed_y`): the corner, or the bed centre. G-code coordinates are
+    /// bed-frame coordinates less this offset.
+    pub fn origin_offset(&self) -> [f64; 2] {
+        match self.origin {
+            Origin::Corner => [0.0, 0.0],
+            Origin::Centre => [self.bed_x / 2.0, self.bed_y / 2.0],
+        }
+    }
+
+    /// True when the bed-frame point (x, y) lies on the bed (its real shape).
+    pub fn on_bed(&self, x: f64, y: f64, eps: f64) -> bool {
+        match self.bed_shape {
+            BedShape::Rectangle => {
+                x >= -eps && y >= -eps && x <= self.bed_x + eps && y <= self.bed_y + eps
+            }
+            BedShape::Circle => {
+                let r = self.bed_x / 2.0;
+                let (dx, dy) = (x - r, y - self.bed_y / 2.0);
+                dx * dx + dy * dy <= (r + eps) * (r + eps)
+            }
+        }
+    }
+}
+
 impl Design {
-    /// Centre of the design on the bed: `shape.center`, or the bed centre.
+    /// Centre of the design in the bed frame: `shape.center` (given in the printer's own
+    /// coordinates), or the bed centre.
     pub fn center(&self) -> [f64; 2] {
-        self.shape
-            .center
-            .unwrap_or([self.printer.bed_x / 2.0, self.printer.bed_y / 2.0])
+        let [ox, oy] = self.printer.origin_offset();
+        match self.shape.center {
+            Some([x, y]) => [x + ox, y + oy],
+            None => [self.printer.bed_x / 2.0, self.printer.bed_y / 2.0],
+        }
     }
 
     /// The design as TOML text, in the file format it was read from.

@@ -1,4 +1,5 @@
-//! G-code (SPEC §5): Marlin-flavoured, plain ASCII, one command per line, deterministic.
+//! G-code (SPEC §5, §12): plain ASCII, one command per line, deterministic, in the printer's
+//! own frame, between the dialect's (or the profile's) start and end G-code.
 //!
 //! Extrusion per segment: `V = line_width × thickness × length_xy × flow`, and
 //! `E = V / (π·feed_diameter²/4) × flow_multiplier`. Thickness is the local layer height of the
@@ -8,8 +9,12 @@
 
 use std::io::{self, Write};
 
-use crate::design::{Design, ExtrusionMode};
+use glam::DVec3;
+
+use crate::design::{BedShape, Design, Dialect, ExtrusionMode, Kinematics, Origin};
+use crate::motion;
 use crate::pipeline::PrintJob;
+use crate::templates::Values;
 use crate::toolpath::Toolpath;
 
 /// Height above the first and last point for the approach and exit moves, mm.
@@ -24,10 +29,13 @@ pub struct JobSummary {
     pub layers: usize,
     pub points: usize,
     pub path_length_mm: f64,
-    /// Estimated time including approach and exit, s.
+    /// Estimated time including approach and exit, s, planned as firmware plans the moves
+    /// ([`crate::motion`]: the printer's acceleration and cornering limit).
     pub estimated_time_s: f64,
     /// Extruded volume, mm³.
     pub volume_mm3: f64,
+    /// Length of "filament" the extruder advances (the sum of E), mm.
+    pub e_length_mm: f64,
 }
 
 /// Approach and exit moves: (approach start height, exit height).
@@ -49,25 +57,64 @@ fn segment_volume(design: &Design, tp: &Toolpath, i: usize) -> f64 {
     design.printer.line_width * b.thickness.max(0.0) * len * b.flow
 }
 
+/// Where the nozzle is when the start G-code has homed, in the bed frame: a delta at the top
+/// of its column over the centre, other printers at the origin corner.
+fn home_position(p: &crate::design::Printer) -> DVec3 {
+    match p.kinematics {
+        Kinematics::Delta => DVec3::new(p.bed_x / 2.0, p.bed_y / 2.0, p.max_z),
+        _ => DVec3::ZERO,
+    }
+}
+
+/// The moves of the whole job as the motion planner sees them, from the home position: the
+/// approach (up, over, down), the path, the exit lift.
+fn planned_moves(design: &Design, tp: &Toolpath) -> (DVec3, Vec<motion::Move>) {
+    let p = &design.printer;
+    let (z_in, z_out) = clearance_heights(design, tp);
+    let mut moves = Vec::with_capacity(tp.points.len() + 4);
+    let home = home_position(p);
+    if let (Some(f), Some(l)) = (tp.points.first(), tp.points.last()) {
+        let travel = p.travel_speed;
+        moves.push(motion::Move {
+            to: DVec3::new(home.x, home.y, z_in),
+            speed: travel,
+        });
+        moves.push(motion::Move {
+            to: DVec3::new(f.pos.x, f.pos.y, z_in),
+            speed: travel,
+        });
+        moves.push(motion::Move {
+            to: f.pos,
+            speed: travel,
+        });
+        moves.extend(tp.points[1..].iter().map(|q| motion::Move {
+            to: q.pos,
+            speed: q.speed,
+        }));
+        moves.push(motion::Move {
+            to: DVec3::new(l.pos.x, l.pos.y, z_out),
+            speed: travel,
+        });
+    }
+    (home, moves)
+}
+
 /// Length, time and volume of a job.
 pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
+    let p = &design.printer;
     let tp = &job.toolpath;
-    let (z_in, z_out) = clearance_heights(design, tp);
-    let travel = match (tp.points.first(), tp.points.last()) {
-        (Some(f), Some(l)) => {
-            (z_in - f.pos.z).abs() * 2.0 + f.pos.truncate().length() + (z_out - l.pos.z).abs()
-        }
-        _ => 0.0,
-    };
-    let volume = (1..tp.points.len())
+    let volume: f64 = (1..tp.points.len())
         .map(|i| segment_volume(design, tp, i))
         .sum();
+    let (home, moves) = planned_moves(design, tp);
+    let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
     JobSummary {
         layers: job.surface.layers,
         points: tp.points.len(),
         path_length_mm: tp.length(),
-        estimated_time_s: tp.print_time() + travel / design.printer.travel_speed,
+        estimated_time_s: motion::plan_time(home, &moves, p.max_acceleration, p.junction_deviation),
         volume_mm3: volume,
+        e_length_mm: volume * p.flow_multiplier / feed_area,
     }
 }
 
@@ -82,11 +129,132 @@ pub fn format_duration(seconds: f64) -> String {
     }
 }
 
-/// Writes the whole G-code program of a job.
+/// PrusaSlicer's duration form (`1h 2m 3s`, `4m 5s`), which its G-code viewer reads back.
+fn prusa_duration(seconds: f64) -> String {
+    let s = seconds.max(0.0).round() as u64;
+    let (d, h, m, s) = (s / 86_400, (s / 3600) % 24, (s / 60) % 60, s % 60);
+    match (d, h, m) {
+        (0, 0, 0) => format!("{s}s"),
+        (0, 0, _) => format!("{m}m {s}s"),
+        (0, _, _) => format!("{h}h {m}m {s}s"),
+        _ => format!("{d}d {h}h {m}m {s}s"),
+    }
+}
+
+/// Why a job cannot be written as G-code (a template that cannot be filled).
+#[derive(Debug, thiserror::Error)]
+pub enum GcodeWriteError {
+    #[error("{field}: {error}")]
+    Template {
+        field: &'static str,
+        error: crate::templates::TemplateError,
+    },
+    #[error(transparent)]
+    Io(#[from] io::Error),
+}
+
+impl From<GcodeWriteError> for io::Error {
+    fn from(e: GcodeWriteError) -> io::Error {
+        match e {
+            GcodeWriteError::Io(e) => e,
+            other => io::Error::new(io::ErrorKind::InvalidInput, other.to_string()),
+        }
+    }
+}
+
+/// The placeholder values of a job's templates, in the printer's own coordinates.
+pub fn template_values(design: &Design, job: &PrintJob, summary: &JobSummary) -> Values {
+    let p = &design.printer;
+    let tp = &job.toolpath;
+    let [ox, oy] = p.origin_offset();
+    let (first, last) = match (tp.points.first(), tp.points.last()) {
+        (Some(f), Some(l)) => (f.pos, l.pos),
+        _ => (DVec3::ZERO, DVec3::ZERO),
+    };
+    let top = tp.points.iter().map(|q| q.pos.z).fold(0.0, f64::max);
+    let park_z = (top + CLEARANCE).min(p.max_z);
+    // Present the part: the back of the bed comes forward on a bed slinger, the head goes
+    // to the back on a gantry; the back left corner suits both (the back edge of a round bed).
+    let (park_x, park_y) = match p.bed_shape {
+        BedShape::Rectangle => (0.0 - ox, p.bed_y - oy),
+        BedShape::Circle => (p.bed_x / 2.0 - ox, p.bed_y - oy),
+    };
+    let f3 = |v: f64| {
+        let mut b = Vec::new();
+        put_fixed(&mut b, v, 3);
+        String::from_utf8(b).unwrap_or_default()
+    };
+    vec![
+        ("bed_x", f3(p.bed_x)),
+        ("bed_y", f3(p.bed_y)),
+        ("max_z", f3(p.max_z)),
+        ("first_x", f3(first.x - ox)),
+        ("first_y", f3(first.y - oy)),
+        ("first_z", f3(first.z)),
+        ("last_z", f3(last.z)),
+        ("top_z", f3(top)),
+        ("park_z", f3(park_z)),
+        ("park_x", f3(park_x)),
+        ("park_y", f3(park_y)),
+        ("layer_height", f3(p.layer_height)),
+        ("line_width", f3(p.line_width)),
+        ("nozzle_diameter", f3(p.nozzle_diameter)),
+        ("layers", summary.layers.to_string()),
+        ("print_time_s", format!("{:.0}", summary.estimated_time_s)),
+        ("print_time", format_duration(summary.estimated_time_s)),
+        (
+            "clay_volume_cm3",
+            format!("{:.1}", summary.volume_mm3 / 1000.0),
+        ),
+        (
+            "design_name",
+            design.name.replace(['\n', '\r', '{', '}'], " "),
+        ),
+        (
+            "e_mode",
+            match p.extrusion {
+                ExtrusionMode::Relative => "M83".into(),
+                ExtrusionMode::Absolute => "M82".into(),
+            },
+        ),
+        ("travel_feed", format!("{:.0}", p.travel_speed * 60.0)),
+    ]
+}
+
+/// Writes the whole G-code program of a job: header (settings, host metadata, thumbnails),
+/// start G-code, approach, the one continuous path (with progress and layer messages), exit,
+/// end G-code. Coordinates are in the printer's own frame (SPEC §12).
 pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::Result<()> {
+    write_program(design, job, out).map_err(io::Error::from)
+}
+
+/// [`write_gcode`] with its errors kept apart (a template that cannot be filled names its field).
+pub fn write_program(
+    design: &Design,
+    job: &PrintJob,
+    out: &mut dyn Write,
+) -> Result<(), GcodeWriteError> {
     let p = &design.printer;
     let tp = &job.toolpath;
     let summary = summarize(design, job);
+    let values = template_values(design, job, &summary);
+    let fill = |field: &'static str, t: &str| {
+        crate::templates::fill(t, &values)
+            .map_err(|error| GcodeWriteError::Template { field, error })
+    };
+    let start = fill(
+        "printer.start_gcode",
+        p.start_gcode
+            .as_deref()
+            .unwrap_or(crate::templates::default_start(p)),
+    )?;
+    let end = fill(
+        "printer.end_gcode",
+        p.end_gcode
+            .as_deref()
+            .unwrap_or(crate::templates::default_end(p)),
+    )?;
+    let layers_total = tp.layer_starts.len().max(1);
     let mut head = String::new();
     use std::fmt::Write as _;
     let _ = writeln!(
@@ -95,6 +263,30 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
         env!("CARGO_PKG_VERSION")
     );
     let _ = writeln!(head, "; design: {}", design.name.replace(['\n', '\r'], " "));
+    let _ = writeln!(
+        head,
+        "; printer: {}, {} bed {}, origin {}, {} firmware",
+        p.profile
+            .as_deref()
+            .unwrap_or("the paper's printer (defaults)"),
+        match p.bed_shape {
+            BedShape::Rectangle => "rectangular",
+            BedShape::Circle => "round",
+        },
+        match p.bed_shape {
+            BedShape::Rectangle => format!("{} x {} mm", p.bed_x, p.bed_y),
+            BedShape::Circle => format!("{} mm across", p.bed_x),
+        },
+        match p.origin {
+            Origin::Corner => "at the front left corner",
+            Origin::Centre => "at the bed centre",
+        },
+        match p.dialect {
+            Dialect::Marlin => "Marlin",
+            Dialect::Klipper => "Klipper",
+            Dialect::RepRapFirmware => "RepRapFirmware",
+        }
+    );
     let _ = writeln!(
         head,
         "; layers: {} (pitch {:.3} mm), points: {}, path length: {:.1} mm, clay volume: {:.1} cm3",
@@ -106,9 +298,11 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
     );
     let _ = writeln!(
         head,
-        "; estimated time: {} ({:.0} s)",
+        "; estimated time: {} ({:.0} s, acceleration {} mm/s2, junction deviation {} mm)",
         format_duration(summary.estimated_time_s),
-        summary.estimated_time_s
+        summary.estimated_time_s,
+        p.max_acceleration,
+        p.junction_deviation
     );
     let _ = writeln!(
         head,
@@ -129,7 +323,7 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
     );
     let _ = writeln!(
         head,
-        "{LIMITS_KEY} bed_x={} bed_y={} max_z={} line_width={} min_layer_height={} max_layer_height={} nozzle_length={} max_overhang_deg={}",
+        "{LIMITS_KEY} bed_x={} bed_y={} max_z={} line_width={} min_layer_height={} max_layer_height={} nozzle_length={} max_overhang_deg={} bed_shape={} origin={}",
         p.bed_x,
         p.bed_y,
         p.max_z,
@@ -137,25 +331,71 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
         p.min_layer_height,
         p.max_layer_height,
         p.nozzle_length,
-        p.max_overhang_deg
+        p.max_overhang_deg,
+        match p.bed_shape {
+            BedShape::Rectangle => "rectangle",
+            BedShape::Circle => "circle",
+        },
+        match p.origin {
+            Origin::Corner => "corner",
+            Origin::Centre => "centre",
+        }
     );
     for f in &job.surface.findings {
         let _ = writeln!(head, "; {f}");
     }
-    let _ = writeln!(head, "G21 ; millimetres");
-    let _ = writeln!(head, "G90 ; absolute positions");
-    let _ = writeln!(
-        head,
-        "{}",
-        match p.extrusion {
-            ExtrusionMode::Relative => "M83 ; relative extrusion",
-            ExtrusionMode::Absolute => "M82 ; absolute extrusion",
-        }
-    );
-    let _ = writeln!(head, "G92 E0");
+    if p.host_metadata {
+        // The forms printer hosts read: Cura's (OctoPrint plugins, Cura-format readers, printer
+        // screens) and PrusaSlicer's (its G-code viewer, Moonraker's PrusaSlicer parser).
+        let _ = writeln!(
+            head,
+            ";FLAVOR:{}",
+            match p.dialect {
+                Dialect::Marlin => "Marlin",
+                Dialect::Klipper => "Klipper",
+                Dialect::RepRapFirmware => "RepRap",
+            }
+        );
+        let _ = writeln!(head, ";TIME:{:.0}", summary.estimated_time_s);
+        let _ = writeln!(head, ";Filament used: {:.5}m", summary.e_length_mm / 1000.0);
+        let _ = writeln!(head, ";Layer height: {}", p.layer_height);
+        let _ = writeln!(head, ";LAYER_COUNT:{layers_total}");
+        let _ = writeln!(
+            head,
+            "; estimated printing time (normal mode) = {}",
+            prusa_duration(summary.estimated_time_s)
+        );
+        let _ = writeln!(head, "; filament used [mm] = {:.2}", summary.e_length_mm);
+        let _ = writeln!(
+            head,
+            "; filament used [cm3] = {:.2}",
+            summary.volume_mm3 / 1000.0
+        );
+        let _ = writeln!(head, "; total layers count = {layers_total}");
+    }
+    if p.thumbnail {
+        let points: Vec<DVec3> = tp.points.iter().map(|q| q.pos).collect();
+        head.push_str(&crate::thumbnail::header_blocks(&points));
+    }
+    head.push_str(&start);
+    if !start.ends_with('\n') {
+        head.push('\n');
+    }
+    // Whatever a custom start G-code does, the path needs absolute positions and its E mode.
+    head.push_str(match p.extrusion {
+        ExtrusionMode::Relative => "G90\nM83\nG92 E0 ; positions and E as the path needs them\n",
+        ExtrusionMode::Absolute => "G90\nM82\nG92 E0 ; positions and E as the path needs them\n",
+    });
     out.write_all(head.as_bytes())?;
 
+    let [ox, oy] = p.origin_offset();
     let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+    let put_xy = |buf: &mut Vec<u8>, q: DVec3| {
+        buf.extend_from_slice(b"X");
+        put_fixed(buf, q.x - ox, 3);
+        buf.extend_from_slice(b" Y");
+        put_fixed(buf, q.y - oy, 3);
+    };
     let (z_in, z_out) = clearance_heights(design, tp);
     let travel_f = p.travel_speed * 60.0;
     if let Some(first) = tp.points.first() {
@@ -163,10 +403,8 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
         put_fixed(&mut buf, z_in, 3);
         buf.extend_from_slice(b" F");
         put_fixed(&mut buf, travel_f, 0);
-        buf.extend_from_slice(b" ; approach\nG0 X");
-        put_fixed(&mut buf, first.pos.x, 3);
-        buf.extend_from_slice(b" Y");
-        put_fixed(&mut buf, first.pos.y, 3);
+        buf.extend_from_slice(b" ; approach\nG0 ");
+        put_xy(&mut buf, first.pos);
         buf.extend_from_slice(b"\nG0 Z");
         put_fixed(&mut buf, first.pos.z, 3);
         buf.push(b'\n');
@@ -175,13 +413,47 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
     let e_per_mm3 = p.flow_multiplier / feed_area;
     let mut e_total = 0.0;
     let mut last_speed = f64::NAN;
+    // Progress: time into the print at each point (the nominal-speed estimate scaled to the
+    // planned total, so M73 counts down to the planned end).
+    let nominal: f64 = tp.print_time().max(1e-9);
+    let scale = summary.estimated_time_s / nominal;
+    let mut t_done = 0.0;
+    let mut last_percent = u64::MAX;
+    let mut next_layer = 0usize;
     for i in 1..tp.points.len() {
         let q = &tp.points[i];
+        if p.host_metadata || p.progress {
+            // The layer that starts at this point (or at the point before it: the first point
+            // of the path is where the approach ends).
+            while next_layer < tp.layer_starts.len() && tp.layer_starts[next_layer] <= i {
+                let n = next_layer + 1;
+                if p.host_metadata {
+                    buf.extend_from_slice(format!(";LAYER:{}\n", n - 1).as_bytes());
+                    match p.dialect {
+                        Dialect::Klipper => buf.extend_from_slice(
+                            format!("SET_PRINT_STATS_INFO CURRENT_LAYER={n}\n").as_bytes(),
+                        ),
+                        _ => buf.extend_from_slice(
+                            format!("M117 Layer {n}/{layers_total}\n").as_bytes(),
+                        ),
+                    }
+                }
+                next_layer += 1;
+            }
+            if p.progress {
+                let percent = ((t_done / nominal) * 100.0).floor().clamp(0.0, 100.0) as u64;
+                if percent != last_percent {
+                    let left_min = ((nominal - t_done) * scale / 60.0).ceil().max(0.0);
+                    buf.extend_from_slice(format!("M73 P{percent} R{left_min:.0}\n").as_bytes());
+                    last_percent = percent;
+                }
+            }
+        }
+        let prev = &tp.points[i - 1];
+        t_done += prev.pos.distance(q.pos) / q.speed;
         let e = segment_volume(design, tp, i) * e_per_mm3;
-        buf.extend_from_slice(b"G1 X");
-        put_fixed(&mut buf, q.pos.x, 3);
-        buf.extend_from_slice(b" Y");
-        put_fixed(&mut buf, q.pos.y, 3);
+        buf.extend_from_slice(b"G1 ");
+        put_xy(&mut buf, q.pos);
         buf.extend_from_slice(b" Z");
         put_fixed(&mut buf, q.pos.z, 3);
         buf.extend_from_slice(b" E");
@@ -198,7 +470,7 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
             last_speed = q.speed;
         }
         buf.push(b'\n');
-        if buf.len() > (1 << 16) - 128 {
+        if buf.len() > (1 << 16) - 256 {
             out.write_all(&buf)?;
             buf.clear();
         }
@@ -210,8 +482,16 @@ pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::
         put_fixed(&mut buf, travel_f, 0);
         buf.extend_from_slice(b" ; exit\n");
     }
+    if p.progress {
+        buf.extend_from_slice(b"M73 P100 R0\n");
+    }
+    buf.extend_from_slice(end.as_bytes());
+    if !end.ends_with('\n') {
+        buf.push(b'\n');
+    }
     buf.extend_from_slice(b"; end\n");
-    out.write_all(&buf)
+    out.write_all(&buf)?;
+    Ok(())
 }
 
 /// Two-digit pairs "00" … "99", for writing integers two digits per division.

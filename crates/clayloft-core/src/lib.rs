@@ -1,7 +1,8 @@
 //! Clayloft core: from a design file to a single spiral G-code path, without a window.
 //!
 //! The pipeline, in order (each stage a function from plain data to plain data):
-//! 1. [`load`] reads and [`validate`]s a [`design::Design`] (SPEC §6);
+//! 1. [`load`] reads and [`validate`]s a [`design::Design`] (SPEC §6), with the printer
+//!    [`profile`] it names (SPEC §12);
 //! 2. [`contour`] builds the two closed curves ([`spline`] for user splines, [`trace`] for
 //!    pictures, [`svg`] for drawings, through [`outline`]), [`align`] puts their
 //!    anchors on the design centre, [`sample`] samples them by arc length and corresponds them;
@@ -9,8 +10,10 @@
 //!    [`section`] on a layer plan that keeps layer heights printable;
 //! 4. [`constraint`] corrects the overhang locally and [`report`]s each correction;
 //! 5. [`texture`] embeds the periodic waves within the same limits;
-//! 6. [`toolpath`] joins the sections into one spiral, [`gcode`] writes it, [`stl`] meshes the
-//!    wall; [`check`] re-measures any G-code file against the printer's limits.
+//! 6. [`toolpath`] joins the sections into one spiral, [`gcode`] writes it between the
+//!    dialect's [`templates`] with the host metadata and a [`thumbnail`], timed by [`motion`]
+//!    as firmware plans it; [`stl`] meshes the wall; [`check`] re-measures any G-code file
+//!    against the printer's limits.
 //!
 //! [`pipeline`] is the loop over these stages.
 pub mod align;
@@ -25,8 +28,10 @@ pub mod geometry;
 pub mod interp;
 pub mod load;
 pub mod loft;
+pub mod motion;
 pub mod outline;
 pub mod pipeline;
+pub mod profile;
 pub mod report;
 pub mod sample;
 pub mod section;
@@ -34,7 +39,9 @@ pub mod shape;
 pub mod spline;
 pub mod stl;
 pub mod svg;
+pub mod templates;
 pub mod texture;
+pub mod thumbnail;
 pub mod toolpath;
 pub mod trace;
 pub mod validate;

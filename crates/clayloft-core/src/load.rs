@@ -46,8 +46,14 @@ impl LoadedDesign {
     }
 }
 
-/// Reads, parses and validates a design file.
+/// Reads, parses and validates a design file (with the printer profile it names, if any).
 pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
+    load_design_using(path, None)
+}
+
+/// As [`load_design`], with printer profile `printer` (a shipped name or a profile file) in
+/// place of the one the design names (`clayloft gcode --printer`).
+pub fn load_design_using(path: &Path, printer: Option<&str>) -> Result<LoadedDesign, DesignError> {
     let file = path.display().to_string();
     let read_err = |reason: String| DesignError::Read {
         file: file.clone(),
@@ -66,30 +72,158 @@ pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
     let bytes = std::fs::read(path).map_err(|e| read_err(io_reason(&e)))?;
     let source = String::from_utf8(bytes)
         .map_err(|_| read_err("it is not a text (UTF-8) file — is it a design?".into()))?;
-    load_design_text(path, source)
+    load_design_text_using(path, source, printer)
 }
 
 /// Parses and validates the text of the design file `path` (already read); errors are located
 /// in that text as [`load_design`]'s are.
 pub fn load_design_text(path: &Path, source: String) -> Result<LoadedDesign, DesignError> {
-    let file = path.display().to_string();
-    let mut design = parse_design(&source).map_err(|e| match e {
-        ParseError::Syntax { line, message } => DesignError::Syntax {
-            file: file.clone(),
-            line,
-            message,
-        },
-        ParseError::Field(f) => located(path, &source, f),
-    })?;
-    design.base_dir = Some(match path.parent() {
+    load_design_text_using(path, source, None)
+}
+
+/// As [`load_design_text`], with printer profile `printer` in place of the design's own pick.
+pub fn load_design_text_using(
+    path: &Path,
+    source: String,
+    printer: Option<&str>,
+) -> Result<LoadedDesign, DesignError> {
+    let base_dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    });
+        _ => PathBuf::from("."),
+    };
+    let mut design = resolve(&source, Some(&base_dir), printer).map_err(|e| e.at(path, &source))?;
+    design.base_dir = Some(base_dir);
     Ok(LoadedDesign {
         design,
         path: path.to_path_buf(),
         source,
     })
+}
+
+/// A design-text problem, or one in the printer profile it names (with that file's name).
+enum ResolveError {
+    Design(ParseError),
+    Profile(DesignError),
+}
+
+impl ResolveError {
+    fn at(self, path: &Path, source: &str) -> DesignError {
+        match self {
+            ResolveError::Design(ParseError::Syntax { line, message }) => DesignError::Syntax {
+                file: path.display().to_string(),
+                line,
+                message,
+            },
+            ResolveError::Design(ParseError::Field(f)) => located(path, source, f),
+            ResolveError::Profile(e) => e,
+        }
+    }
+}
+
+fn syntax(source: &str, e: toml::de::Error) -> ParseError {
+    let line = e.span().map(|s| line_of(source, s.start)).unwrap_or(1);
+    ParseError::Syntax {
+        line,
+        message: first_line(e.message()),
+    }
+}
+
+/// Design text → a validated design: the text alone (syntax, types, unknown fields), then the
+/// printer profile it names (checked alone, located in its own file), the design's own
+/// `[printer]` fields over the profile's, and the whole validated. A field error on a printer
+/// field the design does not set itself is reported in the profile's file.
+fn resolve(
+    source: &str,
+    base_dir: Option<&Path>,
+    printer: Option<&str>,
+) -> Result<Design, ResolveError> {
+    let design: Design =
+        toml::from_str(source).map_err(|e| ResolveError::Design(syntax(source, e)))?;
+    let profile_name = printer
+        .map(str::to_string)
+        .or(design.printer.profile.clone());
+    let Some(name) = profile_name else {
+        let mut design = design;
+        design.printer.normalize();
+        validate(&design).map_err(|e| ResolveError::Design(ParseError::Field(e)))?;
+        return Ok(design);
+    };
+    let found = crate::profile::find(&name, base_dir).map_err(|e| {
+        ResolveError::Design(ParseError::Field(FieldError::new(
+            "printer.profile",
+            e.to_string(),
+        )))
+    })?;
+    let profile_file = found.file.display().to_string();
+    let profile: crate::profile::ProfileFile = toml::from_str(&found.text).map_err(|e| {
+        let ParseError::Syntax { line, message } = syntax(&found.text, e) else {
+            unreachable!("syntax() gives syntax errors")
+        };
+        ResolveError::Profile(DesignError::Syntax {
+            file: profile_file.clone(),
+            line,
+            message,
+        })
+    })?;
+    let mut alone = profile.printer.clone();
+    alone.normalize();
+    crate::validate::validate_printer(&alone)
+        .map_err(|e| ResolveError::Profile(located(&found.file, &found.text, e)))?;
+    // The design's own [printer] fields over the profile's.
+    let design_table: toml::Table =
+        toml::from_str(source).map_err(|e| ResolveError::Design(syntax(source, e)))?;
+    let profile_table: toml::Table = toml::from_str(&found.text).map_err(|e| {
+        ResolveError::Profile(DesignError::Syntax {
+            file: profile_file.clone(),
+            line: 1,
+            message: first_line(e.message()),
+        })
+    })?;
+    let mut merged_printer = profile_table
+        .get("printer")
+        .and_then(|v| v.as_table())
+        .cloned()
+        .unwrap_or_default();
+    let own = design_table
+        .get("printer")
+        .and_then(|v| v.as_table())
+        .cloned()
+        .unwrap_or_default();
+    for (k, v) in &own {
+        merged_printer.insert(k.clone(), v.clone());
+    }
+    merged_printer.insert("profile".into(), toml::Value::String(name.clone()));
+    let mut merged = design_table;
+    merged.insert("printer".into(), toml::Value::Table(merged_printer));
+    let mut design: Design =
+        toml::Value::Table(merged)
+            .try_into()
+            .map_err(|e: toml::de::Error| {
+                ResolveError::Design(ParseError::Syntax {
+                    line: 1,
+                    message: format!("with printer profile {name}: {}", first_line(e.message())),
+                })
+            })?;
+    design.printer.normalize();
+    validate(&design).map_err(|e| {
+        let key = e
+            .field
+            .strip_prefix("printer.")
+            .map(|k| k.split(['.', '[']).next().unwrap_or(k));
+        match key {
+            Some(k)
+                if !own.contains_key(k)
+                    && profile_table
+                        .get("printer")
+                        .and_then(|v| v.as_table())
+                        .is_some_and(|t| t.contains_key(k)) =>
+            {
+                ResolveError::Profile(located(&found.file, &found.text, e))
+            }
+            _ => ResolveError::Design(ParseError::Field(e)),
+        }
+    })?;
+    Ok(design)
 }
 
 /// A problem in design text, before a file name is attached.
@@ -99,17 +233,16 @@ pub enum ParseError {
     Field(FieldError),
 }
 
-/// Parses and validates design text.
+/// Parses and validates design text (a printer profile it names must be a shipped one: there is
+/// no folder to find a profile file in).
 pub fn parse_design(source: &str) -> Result<Design, ParseError> {
-    let design: Design = toml::from_str(source).map_err(|e| {
-        let line = e.span().map(|s| line_of(source, s.start)).unwrap_or(1);
-        ParseError::Syntax {
-            line,
-            message: first_line(e.message()),
-        }
-    })?;
-    validate(&design).map_err(ParseError::Field)?;
-    Ok(design)
+    resolve(source, None, None).map_err(|e| match e {
+        ResolveError::Design(p) => p,
+        ResolveError::Profile(d) => ParseError::Syntax {
+            line: 1,
+            message: d.to_string(),
+        },
+    })
 }
 
 fn io_reason(e: &std::io::Error) -> String {

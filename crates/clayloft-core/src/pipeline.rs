@@ -138,14 +138,45 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
     } else {
         "shape"
     };
-    for (axis, lo, hi, size) in [("x", lo.x, hi.x, p.bed_x), ("y", lo.y, hi.y, p.bed_y)] {
-        if lo < 0.0 || hi > size {
-            return Err(FieldError::new(
-                field,
-                format!(
-                    "the vessel spans {axis} = {lo:.1} … {hi:.1} mm but the bed is 0 … {size} mm (printer.bed_{axis}); make it smaller or move it"
-                ),
-            ));
+    let [ox, oy] = p.origin_offset();
+    match p.bed_shape {
+        crate::design::BedShape::Rectangle => {
+            for (axis, lo, hi, size, o) in [
+                ("x", lo.x, hi.x, p.bed_x, ox),
+                ("y", lo.y, hi.y, p.bed_y, oy),
+            ] {
+                if lo < 0.0 || hi > size {
+                    return Err(FieldError::new(
+                        field,
+                        format!(
+                            "the vessel spans {axis} = {:.1} … {:.1} mm but the bed is {} … {} mm (printer.bed_{axis}); make it smaller or move it",
+                            lo - o,
+                            hi - o,
+                            -o,
+                            size - o
+                        ),
+                    ));
+                }
+            }
+        }
+        crate::design::BedShape::Circle => {
+            let c = DVec2::new(p.bed_x / 2.0, p.bed_y / 2.0);
+            let reach = surface
+                .sections
+                .iter()
+                .flat_map(|s| s.points.iter())
+                .map(|q| q.truncate().distance(c))
+                .fold(0.0, f64::max)
+                + half;
+            if reach > p.bed_x / 2.0 {
+                return Err(FieldError::new(
+                    field,
+                    format!(
+                        "the vessel reaches {reach:.1} mm from the bed centre but the round bed's radius is {} mm (printer.bed_diameter); make it smaller or move it",
+                        p.bed_x / 2.0
+                    ),
+                ));
+            }
         }
     }
     if top > p.max_z {

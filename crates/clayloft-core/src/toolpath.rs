@@ -41,6 +41,9 @@ pub struct Toolpath {
     pub base_points: usize,
     /// Number of wall revolutions (flat first revolution, helix and rim).
     pub revolutions: usize,
+    /// Index of the first point of each layer, in order: each base layer, then each wall
+    /// revolution (for host layer messages and progress).
+    pub layer_starts: Vec<usize>,
 }
 
 impl Toolpath {
@@ -101,6 +104,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
         speed: p.print_speed,
     };
 
+    let mut layer_starts = Vec::with_capacity(layers + base + 2);
     // 1. Spiral base: layers 1 ..= base, alternating direction so the last one ends at the wall.
     //    All layers share one ring layout (from the widest), so their rings stack.
     let r_max = (1..=base)
@@ -130,6 +134,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
             })?;
         let outward = (base - layer).is_multiple_of(2);
         let start = b.points.len();
+        layer_starts.push(start);
         let ordered: Box<dyn Iterator<Item = &DVec3>> = if outward {
             Box::new(geometry.iter())
         } else {
@@ -149,6 +154,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     if base == 0 {
         let ring = &sections[first];
         let start = b.points.len();
+        layer_starts.push(start);
         for i in 0..=n {
             let q = ring.points[i % n];
             b.push(DVec3::new(q.x, q.y, flat_z), flat_z);
@@ -163,6 +169,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
         let (lo, hi) = (&sections[k], &sections[k + 1]);
         let frac = arc_fractions(lo);
         let start = b.points.len();
+        layer_starts.push(start);
         let mut z_now = vec![0.0; n];
         for i in 1..=n {
             let f = frac[i];
@@ -205,7 +212,10 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     for i in 1..n {
         let q = top.points[i];
         let thickness = q.z - z_below[i];
-        if thickness < a {
+        // Only while the step onto the rim is a printable layer: with horizontal control lines
+        // the top section is not level, and where it climbs faster than the last revolution
+        // the rim would be a layer thicker than the printer lays (or a bead in the air).
+        if thickness < a || thickness > p.max_layer_height {
             break;
         }
         b.push(q, thickness);
@@ -213,6 +223,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     if b.points.len() > start {
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
         revolutions += 1;
+        layer_starts.push(start);
     }
 
     let mut points = b.points;
@@ -221,10 +232,12 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
         p.flow_ramp_start,
         p.flow_ramp_end,
     );
+    layer_starts.dedup();
     Ok(Toolpath {
         points,
         base_points,
         revolutions,
+        layer_starts,
     })
 }
 

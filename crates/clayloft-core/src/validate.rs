@@ -1,7 +1,7 @@
 //! Physical-range checks on a parsed [`Design`]: every number finite and inside what a clay printer
 //! can do. Each failure names the field (as a dotted path, e.g. `printer.layer_height`) and why.
 
-use crate::design::{ContourSpec, DESIGN_VERSION, Design, Wave};
+use crate::design::{BedShape, ContourSpec, DESIGN_VERSION, Design, Printer, Wave};
 
 /// A problem with one field of a design. `field` is a dotted path such as
 /// `control.vertical[1].points[2]`; the loader turns it into a line number.
@@ -83,19 +83,34 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64, why: &str) -> Check {
     Ok(())
 }
 
-/// Checks every field of a design against physical ranges. Fit on the bed and under the build
-/// height is checked after the shape is computed (see [`crate::pipeline`]).
-pub fn validate(d: &Design) -> Check {
-    if d.version != DESIGN_VERSION {
+/// Checks the printer fields alone (a printer profile is checked with this before it is merged
+/// into a design).
+pub fn validate_printer(p: &Printer) -> Check {
+    for (field, template) in [
+        ("printer.start_gcode", &p.start_gcode),
+        ("printer.end_gcode", &p.end_gcode),
+    ] {
+        if let Some(t) = template {
+            crate::templates::check(t).map_err(|e| FieldError::new(field, e.to_string()))?;
+            if !t.is_ascii() {
+                return Err(FieldError::new(field, "G-code must be plain ASCII"));
+            }
+        }
+    }
+    if p.bed_shape == BedShape::Circle {
+        let Some(dia) = p.bed_diameter else {
+            return Err(FieldError::new(
+                "printer.bed_shape",
+                "a round bed needs printer.bed_diameter (mm)",
+            ));
+        };
+        positive("printer.bed_diameter", dia, "mm")?;
+    } else if p.bed_diameter.is_some() {
         return Err(FieldError::new(
-            "version",
-            format!(
-                "this Clayloft reads design version {DESIGN_VERSION}, the file says {}",
-                d.version
-            ),
+            "printer.bed_diameter",
+            "is for round beds; set printer.bed_shape = \"circle\" or give bed_x and bed_y",
         ));
     }
-    let p = &d.printer;
     positive("printer.bed_x", p.bed_x, "mm")?;
     positive("printer.bed_y", p.bed_y, "mm")?;
     positive("printer.max_z", p.max_z, "mm")?;
@@ -151,6 +166,20 @@ pub fn validate(d: &Design) -> Check {
         80.0,
         "degrees from vertical",
     )?;
+    in_range(
+        "printer.max_acceleration",
+        p.max_acceleration,
+        1.0,
+        100_000.0,
+        "mm/s²",
+    )?;
+    in_range(
+        "printer.junction_deviation",
+        p.junction_deviation,
+        0.0001,
+        10.0,
+        "mm (Marlin's range is 0.001 … 0.5)",
+    )?;
     in_range("printer.print_speed", p.print_speed, 0.1, 1000.0, "mm/s")?;
     in_range("printer.travel_speed", p.travel_speed, 0.1, 1000.0, "mm/s")?;
     positive("printer.feed_diameter", p.feed_diameter, "mm")?;
@@ -183,6 +212,23 @@ pub fn validate(d: &Design) -> Check {
         "mm of path",
     )?;
 
+    Ok(())
+}
+
+/// Checks every field of a design against physical ranges. Fit on the bed and under the build
+/// height is checked after the shape is computed (see [`crate::pipeline`]).
+pub fn validate(d: &Design) -> Check {
+    if d.version != DESIGN_VERSION {
+        return Err(FieldError::new(
+            "version",
+            format!(
+                "this Clayloft reads design version {DESIGN_VERSION}, the file says {}",
+                d.version
+            ),
+        ));
+    }
+    validate_printer(&d.printer)?;
+    let p = &d.printer;
     let s = &d.shape;
     positive("shape.height", s.height, "mm")?;
     if s.height > p.max_z {
@@ -213,8 +259,33 @@ pub fn validate(d: &Design) -> Check {
         ));
     }
     if let Some([cx, cy]) = s.center {
-        in_range("shape.center", cx, 0.0, p.bed_x, "x must lie on the bed")?;
-        in_range("shape.center", cy, 0.0, p.bed_y, "y must lie on the bed")?;
+        // In the printer's own coordinates: 0 … bed size from a corner origin, ± half from a
+        // centre origin.
+        let [ox, oy] = p.origin_offset();
+        in_range(
+            "shape.center",
+            cx,
+            -ox,
+            p.bed_x - ox,
+            "x must lie on the bed",
+        )?;
+        in_range(
+            "shape.center",
+            cy,
+            -oy,
+            p.bed_y - oy,
+            "y must lie on the bed",
+        )?;
+        let [bx, by] = d.center();
+        if !p.on_bed(bx, by, 1e-9) {
+            return Err(FieldError::new(
+                "shape.center",
+                format!(
+                    "[{cx}, {cy}] is off the round bed (diameter {} mm)",
+                    p.bed_x
+                ),
+            ));
+        }
     }
     let layers_nominal = s.height / p.layer_height;
     if s.base_layers as f64 >= layers_nominal {

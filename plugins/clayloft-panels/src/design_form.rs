@@ -89,7 +89,9 @@ fn shape(ui: &mut egui::Ui, d: &mut Design) {
         .on_hover_text("By default the vessel stands at the bed centre.")
         .changed()
     {
-        s.center = custom.then(|| [d.printer.bed_x / 2.0, d.printer.bed_y / 2.0]);
+        // In the printer's own coordinates: the bed centre.
+        let [ox, oy] = d.printer.origin_offset();
+        s.center = custom.then(|| [d.printer.bed_x / 2.0 - ox, d.printer.bed_y / 2.0 - oy]);
     }
     if let Some(c) = &mut s.center {
         number(
@@ -579,7 +581,60 @@ fn texture(ui: &mut egui::Ui, t: &mut Option<Texture>) {
     );
 }
 
+/// Picks one of the shipped printer profiles: its settings replace the printer's (as a slicer
+/// does when another printer is chosen); the design keeps its shape.
+fn printer_picker(ui: &mut egui::Ui, d: &mut Design) {
+    let current = d.printer.profile.clone().unwrap_or_else(|| "custom".into());
+    let mut chosen: Option<&str> = None;
+    egui::ComboBox::from_label("Printer")
+        .selected_text(current.clone())
+        .show_ui(ui, |ui| {
+            for (name, _) in clayloft_core::profile::SHIPPED {
+                if ui.selectable_label(current == *name, *name).clicked() {
+                    chosen = Some(name);
+                }
+            }
+        })
+        .response
+        .on_hover_text("A profile of a real clay printer: bed, build height, nozzle, layers, speeds, firmware, start and end G-code.");
+    if let Some(name) = chosen
+        && let Some((_, text)) = clayloft_core::profile::SHIPPED
+            .iter()
+            .find(|(n, _)| *n == name)
+        && let Ok(file) = clayloft_core::profile::parse_shipped(name, text)
+    {
+        let mut printer = file.printer;
+        printer.profile = Some(name.to_string());
+        d.printer = printer;
+        // A placement made for the old bed need not lie on the new one.
+        d.shape.center = None;
+    }
+    let p = &d.printer;
+    ui.label(match p.bed_shape {
+        clayloft_core::design::BedShape::Rectangle => format!(
+            "bed {} × {} mm, origin {}",
+            p.bed_x,
+            p.bed_y,
+            if p.origin == clayloft_core::design::Origin::Centre {
+                "centre"
+            } else {
+                "corner"
+            }
+        ),
+        clayloft_core::design::BedShape::Circle => format!(
+            "round bed {} mm across, origin {}",
+            p.bed_x,
+            if p.origin == clayloft_core::design::Origin::Centre {
+                "centre"
+            } else {
+                "corner"
+            }
+        ),
+    });
+}
+
 fn printer(ui: &mut egui::Ui, d: &mut Design) {
+    printer_picker(ui, d);
     let p = &mut d.printer;
     explain(
         ui,

@@ -72,6 +72,7 @@ mod tests {
             points: vec![pt(0.0, 10.0), pt(10.0, 10.0), pt(30.0, 20.0)],
             base_points: 0,
             revolutions: 1,
+            layer_starts: vec![0],
         };
         let tl = Timeline::new(&path);
         assert_eq!(tl.total_s(), 2.0);

@@ -119,9 +119,14 @@ fn spawn_scene(
         wall_mesh_bundle(&mut meshes, &mut materials),
         Name::new("wall view"),
     ));
+    let bed_meshes = BedMeshes {
+        rectangle: meshes.add(Cuboid::new(1.0, 1.0, 1.0)),
+        circle: meshes.add(Cylinder::new(0.5, 1.0).mesh().resolution(96)),
+    };
     commands.spawn((
         BedView,
-        Mesh3d(meshes.add(Cuboid::new(1.0, 1.0, 1.0))),
+        Mesh3d(bed_meshes.rectangle.clone()),
+        bed_meshes,
         MeshMaterial3d(materials.add(StandardMaterial {
             base_color: Color::srgb(0.32, 0.34, 0.38),
             perceptual_roughness: 0.95,
@@ -244,16 +249,34 @@ fn rebuild_toolpath_lines(
     let _ = assets.insert(view.handle.id(), asset);
 }
 
-fn update_bed(doc: Option<Res<DesignDoc>>, mut bed: Single<&mut Transform, With<BedView>>) {
+/// The bed's two shapes: a box for a rectangular bed, a disc for a round one.
+#[derive(Component)]
+pub struct BedMeshes {
+    rectangle: Handle<Mesh>,
+    circle: Handle<Mesh>,
+}
+
+fn update_bed(
+    doc: Option<Res<DesignDoc>>,
+    bed: Single<(&mut Transform, &mut Mesh3d, &BedMeshes), With<BedView>>,
+) {
     let Some(doc) = doc else { return };
     if !doc.is_changed() {
         return;
     }
+    let (mut transform, mut mesh, shapes) = bed.into_inner();
     let p = &doc.design.printer;
     let (x, y) = (p.bed_x as f32, p.bed_y as f32);
     // The bed's top face at z = 0; world (x, z, −y).
-    bed.translation = Vec3::new(x / 2.0, -1.0, -y / 2.0);
-    bed.scale = Vec3::new(x, 2.0, y);
+    transform.translation = Vec3::new(x / 2.0, -1.0, -y / 2.0);
+    transform.scale = Vec3::new(x, 2.0, y);
+    let want = match p.bed_shape {
+        clayloft_core::design::BedShape::Rectangle => &shapes.rectangle,
+        clayloft_core::design::BedShape::Circle => &shapes.circle,
+    };
+    if mesh.0 != *want {
+        mesh.0 = want.clone();
+    }
 }
 
 fn apply_view_settings(
@@ -283,21 +306,59 @@ fn draw_build_volume(settings: Res<ViewSettings>, doc: Option<Res<DesignDoc>>, m
     let p = &doc.design.printer;
     let (x, y, z) = (p.bed_x as f32, p.bed_y as f32, p.max_z as f32);
     let center = Vec3::new(x / 2.0, z / 2.0, -y / 2.0);
-    gizmos.cube(
-        Transform::from_translation(center).with_scale(Vec3::new(x, z, y)),
-        Color::srgba(0.6, 0.7, 0.9, 0.35),
-    );
-    // A 10 mm grid on the bed.
-    let color = Color::srgba(0.55, 0.58, 0.62, 0.5);
-    let mut gx = 0.0;
-    while gx <= x {
-        gizmos.line(Vec3::new(gx, 0.05, 0.0), Vec3::new(gx, 0.05, -y), color);
-        gx += 10.0;
-    }
-    let mut gy = 0.0;
-    while gy <= y {
-        gizmos.line(Vec3::new(0.0, 0.05, -gy), Vec3::new(x, 0.05, -gy), color);
-        gy += 10.0;
+    let volume = Color::srgba(0.6, 0.7, 0.9, 0.35);
+    let grid = Color::srgba(0.55, 0.58, 0.62, 0.5);
+    match p.bed_shape {
+        clayloft_core::design::BedShape::Rectangle => {
+            gizmos.cube(
+                Transform::from_translation(center).with_scale(Vec3::new(x, z, y)),
+                volume,
+            );
+            // A 10 mm grid on the bed.
+            let mut gx = 0.0;
+            while gx <= x {
+                gizmos.line(Vec3::new(gx, 0.05, 0.0), Vec3::new(gx, 0.05, -y), grid);
+                gx += 10.0;
+            }
+            let mut gy = 0.0;
+            while gy <= y {
+                gizmos.line(Vec3::new(0.0, 0.05, -gy), Vec3::new(x, 0.05, -gy), grid);
+                gy += 10.0;
+            }
+        }
+        clayloft_core::design::BedShape::Circle => {
+            // The round build volume: its floor and ceiling circles and four edges.
+            let r = x / 2.0;
+            let c = Vec3::new(r, 0.0, -r);
+            let flat = Isometry3d::new(c, Quat::from_rotation_x(std::f32::consts::FRAC_PI_2));
+            gizmos.circle(flat, r, volume).resolution(96);
+            let top = Isometry3d::new(
+                c + Vec3::Y * z,
+                Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
+            );
+            gizmos.circle(top, r, volume).resolution(96);
+            for k in 0..4 {
+                let a = k as f32 * std::f32::consts::FRAC_PI_2;
+                let at = c + Vec3::new(r * a.cos(), 0.0, r * a.sin());
+                gizmos.line(at, at + Vec3::Y * z, volume);
+            }
+            // A 10 mm grid clipped to the disc.
+            let mut g = -r + (r % 10.0);
+            while g <= r {
+                let half = (r * r - g * g).max(0.0).sqrt();
+                gizmos.line(
+                    c + Vec3::new(g, 0.05, -half),
+                    c + Vec3::new(g, 0.05, half),
+                    grid,
+                );
+                gizmos.line(
+                    c + Vec3::new(-half, 0.05, g),
+                    c + Vec3::new(half, 0.05, g),
+                    grid,
+                );
+                g += 10.0;
+            }
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 //! each within the physical range a clay printer can have (so that no header can make the
 //! checker's search grid microscopic or its numbers meaningless).
 
-use crate::design::Printer;
+use crate::design::{BedShape, Origin, Printer};
 use crate::gcode::LIMITS_KEY;
 
 /// The printer limits a G-code file is checked against.
@@ -16,6 +16,10 @@ pub struct Limits {
     pub max_layer_height: f64,
     pub nozzle_length: f64,
     pub max_overhang_deg: f64,
+    /// A round bed is `bed_x` across (and `bed_y` = `bed_x`).
+    pub bed_shape: BedShape,
+    /// Where the file's (0, 0) is: the bed's corner or its centre.
+    pub origin: Origin,
 }
 
 /// A limit outside what a clay printer can have: which, the value, and the range.
@@ -53,6 +57,8 @@ impl From<&Printer> for Limits {
             max_layer_height: p.max_layer_height,
             nozzle_length: p.nozzle_length,
             max_overhang_deg: p.max_overhang_deg,
+            bed_shape: p.bed_shape,
+            origin: p.origin,
         }
     }
 }
@@ -70,6 +76,28 @@ impl Limits {
             "max_overhang_deg" => &mut self.max_overhang_deg,
             _ => return None,
         })
+    }
+
+    /// The file's (0, 0) in the bed frame (see [`Printer::origin_offset`]).
+    pub fn origin_offset(&self) -> [f64; 2] {
+        match self.origin {
+            Origin::Corner => [0.0, 0.0],
+            Origin::Centre => [self.bed_x / 2.0, self.bed_y / 2.0],
+        }
+    }
+
+    /// True when the bed-frame point (x, y) lies on the bed's real shape.
+    pub fn on_bed(&self, x: f64, y: f64, eps: f64) -> bool {
+        match self.bed_shape {
+            BedShape::Rectangle => {
+                x >= -eps && y >= -eps && x <= self.bed_x + eps && y <= self.bed_y + eps
+            }
+            BedShape::Circle => {
+                let r = self.bed_x / 2.0;
+                let (dx, dy) = (x - r, y - self.bed_y / 2.0);
+                dx * dx + dy * dy <= (r + eps) * (r + eps)
+            }
+        }
     }
 
     /// Every limit finite and inside its physical range, the layer range not inverted.
@@ -114,6 +142,21 @@ impl Limits {
             let Some((k, v)) = kv.split_once('=') else {
                 continue;
             };
+            match (k, v) {
+                ("bed_shape", "circle") => l.bed_shape = BedShape::Circle,
+                ("bed_shape", "rectangle") => l.bed_shape = BedShape::Rectangle,
+                ("origin", "centre" | "center") => l.origin = Origin::Centre,
+                ("origin", "corner") => l.origin = Origin::Corner,
+                ("bed_shape" | "origin", _) => {
+                    return Err(LimitsError {
+                        line: Some(index + 1),
+                        key: if k == "origin" { "origin" } else { "bed_shape" },
+                        value: f64::NAN,
+                        why: format!("`{}` is not a known value", truncated(v)),
+                    });
+                }
+                _ => {}
+            }
             let Some((key, _, _)) = RANGES.iter().find(|(name, _, _)| *name == k) else {
                 continue; // a key of a later version
             };
@@ -124,6 +167,9 @@ impl Limits {
                 why: format!("`{}` is not a number", truncated(v)),
             })?;
             *l.field(key).expect("every range names a field") = value;
+        }
+        if l.bed_shape == BedShape::Circle {
+            l.bed_y = l.bed_x;
         }
         l.validate().map_err(|e| LimitsError {
             line: Some(index + 1),

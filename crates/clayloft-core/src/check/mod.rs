@@ -30,7 +30,14 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
         line: e.line.unwrap_or(1),
         message: format!("limits: {e}"),
     })?;
-    let (moves, start) = parse_moves(text)?;
+    let (mut moves, mut start) = parse_moves(text)?;
+    // Into the bed frame: the file's coordinates are the printer's own.
+    let [ox, oy] = limits.origin_offset();
+    let shift = DVec3::new(ox, oy, 0.0);
+    for m in &mut moves {
+        m.to += shift;
+    }
+    start += shift;
     if moves.is_empty() {
         return Err(GcodeError {
             line: 1,
@@ -54,13 +61,7 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
             hi = hi.max(m.to);
         }
         let eps = 1e-6;
-        if m.to.x < -eps
-            || m.to.y < -eps
-            || m.to.x > limits.bed_x + eps
-            || m.to.y > limits.bed_y + eps
-            || m.to.z < -eps
-            || m.to.z > limits.max_z + eps
-        {
+        if !limits.on_bed(m.to.x, m.to.y, eps) || m.to.z < -eps || m.to.z > limits.max_z + eps {
             outside.add(0.0, m.line);
         }
         if m.de < 0.0 {
@@ -84,7 +85,16 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
         [
             outside.into_violation(
                 "outside the machine",
-                format!("bed 0 … {} × 0 … {} mm, height 0 … {} mm", limits.bed_x, limits.bed_y, limits.max_z),
+                match limits.bed_shape {
+                    crate::design::BedShape::Rectangle => format!(
+                        "bed {} … {} × {} … {} mm, height 0 … {} mm",
+                        -ox, limits.bed_x - ox, -oy, limits.bed_y - oy, limits.max_z
+                    ),
+                    crate::design::BedShape::Circle => format!(
+                        "round bed {} mm across, height 0 … {} mm",
+                        limits.bed_x, limits.max_z
+                    ),
+                },
             ),
             travel.into_violation(
                 "not one continuous path",

@@ -125,6 +125,13 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
             "G28" => pos = DVec3::ZERO,
             c if c.starts_with(['G', 'M', 'T', 'N', 'F', 'S']) && c[1..].parse::<f64>().is_ok() => {
             }
+            // Klipper's and RepRapFirmware's named commands (`SET_PRINT_STATS_INFO …`,
+            // `TURN_OFF_HEATERS`): no moves.
+            _ if cmd.len() >= 3
+                && cmd.starts_with(|c: char| c.is_ascii_uppercase())
+                && cmd
+                    .chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_') => {}
             other => {
                 return Err(GcodeError {
                     line,
