@@ -100,6 +100,21 @@ pub enum BedShape {
     Circle,
 }
 
+impl BedShape {
+    /// True when the bed-frame point (x, y) lies on a bed of this shape, `bed_x` × `bed_y`
+    /// (a round bed is `bed_x` across), within `eps`.
+    pub fn contains(self, bed_x: f64, bed_y: f64, x: f64, y: f64, eps: f64) -> bool {
+        match self {
+            BedShape::Rectangle => x >= -eps && y >= -eps && x <= bed_x + eps && y <= bed_y + eps,
+            BedShape::Circle => {
+                let r = bed_x / 2.0;
+                let (dx, dy) = (x - r, y - bed_y / 2.0);
+                dx * dx + dy * dy <= (r + eps) * (r + eps)
+            }
+        }
+    }
+}
+
 /// Where the printer's (0, 0) is on the bed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum Origin {
@@ -110,6 +125,16 @@ pub enum Origin {
     /// The centre of the bed (deltas, some large-format printers).
     #[serde(rename = "centre", alias = "center")]
     Centre,
+}
+
+impl Origin {
+    /// Where this origin lies in the bed frame of a `bed_x` × `bed_y` bed.
+    pub fn offset(self, bed_x: f64, bed_y: f64) -> [f64; 2] {
+        match self {
+            Origin::Corner => [0.0, 0.0],
+            Origin::Centre => [bed_x / 2.0, bed_y / 2.0],
+        }
+    }
 }
 
 /// How the printer moves its nozzle; the start/end G-code and the time estimate follow it.
@@ -437,24 +462,12 @@ impl Printer {
     /// corner, 0 … `bed_x`, 0 … `bed_y`): the corner, or the bed centre. G-code coordinates are
     /// bed-frame coordinates less this offset.
     pub fn origin_offset(&self) -> [f64; 2] {
-        match self.origin {
-            Origin::Corner => [0.0, 0.0],
-            Origin::Centre => [self.bed_x / 2.0, self.bed_y / 2.0],
-        }
+        self.origin.offset(self.bed_x, self.bed_y)
     }
 
     /// True when the bed-frame point (x, y) lies on the bed (its real shape).
     pub fn on_bed(&self, x: f64, y: f64, eps: f64) -> bool {
-        match self.bed_shape {
-            BedShape::Rectangle => {
-                x >= -eps && y >= -eps && x <= self.bed_x + eps && y <= self.bed_y + eps
-            }
-            BedShape::Circle => {
-                let r = self.bed_x / 2.0;
-                let (dx, dy) = (x - r, y - self.bed_y / 2.0);
-                dx * dx + dy * dy <= (r + eps) * (r + eps)
-            }
-        }
+        self.bed_shape.contains(self.bed_x, self.bed_y, x, y, eps)
     }
 }
 

@@ -80,24 +80,12 @@ impl Limits {
 
     /// The file's (0, 0) in the bed frame (see [`Printer::origin_offset`]).
     pub fn origin_offset(&self) -> [f64; 2] {
-        match self.origin {
-            Origin::Corner => [0.0, 0.0],
-            Origin::Centre => [self.bed_x / 2.0, self.bed_y / 2.0],
-        }
+        self.origin.offset(self.bed_x, self.bed_y)
     }
 
     /// True when the bed-frame point (x, y) lies on the bed's real shape.
     pub fn on_bed(&self, x: f64, y: f64, eps: f64) -> bool {
-        match self.bed_shape {
-            BedShape::Rectangle => {
-                x >= -eps && y >= -eps && x <= self.bed_x + eps && y <= self.bed_y + eps
-            }
-            BedShape::Circle => {
-                let r = self.bed_x / 2.0;
-                let (dx, dy) = (x - r, y - self.bed_y / 2.0);
-                dx * dx + dy * dy <= (r + eps) * (r + eps)
-            }
-        }
+        self.bed_shape.contains(self.bed_x, self.bed_y, x, y, eps)
     }
 
     /// Every limit finite and inside its physical range, the layer range not inverted.
