@@ -68,36 +68,73 @@ fn home_position(p: &crate::design::Printer) -> DVec3 {
 
 /// The moves of the whole job as the motion planner sees them, from the home position: the
 /// approach (up, over, down), the path, the exit lift.
-fn planned_moves(design: &Design, tp: &Toolpath) -> (DVec3, Vec<motion::Move>) {
+fn planned_moves<'a>(
+    design: &Design,
+    tp: &'a Toolpath,
+) -> (DVec3, impl ExactSizeIterator<Item = motion::Move> + 'a) {
     let p = &design.printer;
     let (z_in, z_out) = clearance_heights(design, tp);
-    let mut moves = Vec::with_capacity(tp.points.len() + 4);
     let home = home_position(p);
+    let travel = p.travel_speed;
+    let mut ends: Vec<motion::Move> = Vec::new();
+    let mut exit: Vec<motion::Move> = Vec::new();
     if let (Some(f), Some(l)) = (tp.points.first(), tp.points.last()) {
-        let travel = p.travel_speed;
-        moves.push(motion::Move {
+        ends.push(motion::Move {
             to: DVec3::new(home.x, home.y, z_in),
             speed: travel,
         });
-        moves.push(motion::Move {
+        ends.push(motion::Move {
             to: DVec3::new(f.pos.x, f.pos.y, z_in),
             speed: travel,
         });
-        moves.push(motion::Move {
+        ends.push(motion::Move {
             to: f.pos,
             speed: travel,
         });
-        moves.extend(tp.points[1..].iter().map(|q| motion::Move {
-            to: q.pos,
-            speed: q.speed,
-        }));
-        moves.push(motion::Move {
+        exit.push(motion::Move {
             to: DVec3::new(l.pos.x, l.pos.y, z_out),
             speed: travel,
         });
     }
-    (home, moves)
+    let path = tp.points.get(1..).unwrap_or(&[]);
+    let n = ends.len() + path.len() + exit.len();
+    let moves = ends
+        .into_iter()
+        .chain(path.iter().map(|q| motion::Move {
+            to: q.pos,
+            speed: q.speed,
+        }))
+        .chain(exit);
+    (
+        home,
+        ExactLen {
+            inner: moves,
+            left: n,
+        },
+    )
 }
+
+/// An iterator whose length is known (chains of slices and small lists are not `ExactSize`).
+struct ExactLen<I> {
+    inner: I,
+    left: usize,
+}
+
+impl<I: Iterator> Iterator for ExactLen<I> {
+    type Item = I::Item;
+    fn next(&mut self) -> Option<I::Item> {
+        let x = self.inner.next();
+        if x.is_some() {
+            self.left -= 1;
+        }
+        x
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.left, Some(self.left))
+    }
+}
+
+impl<I: Iterator> ExactSizeIterator for ExactLen<I> {}
 
 /// Length, time and volume of a job.
 pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
@@ -112,7 +149,12 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
         layers: job.surface.layers,
         points: tp.points.len(),
         path_length_mm: tp.length(),
-        estimated_time_s: motion::plan_time(home, &moves, p.max_acceleration, p.junction_deviation),
+        estimated_time_s: motion::plan_time_of(
+            home,
+            moves,
+            p.max_acceleration,
+            p.junction_deviation,
+        ),
         volume_mm3: volume,
         e_length_mm: volume * p.flow_multiplier / feed_area,
     }

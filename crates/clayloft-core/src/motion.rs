@@ -2,9 +2,10 @@
 //! printer's acceleration `a` (trapezoidal speed profiles), corners are taken at the speed the
 //! cornering limit allows, and the planner looks ahead so that it can always stop.
 //!
-//! Junction speed (Marlin's junction deviation δ, `planner.cpp`): with θ the angle between the two
-//! moves' directions (0 = straight on), `sin(θ/2) = √((1 − cos θ)/2)` and
-//! `v² = a·δ·sin(θ/2) / (1 − sin(θ/2))` — unlimited going straight, zero reversing. Klipper's
+//! Junction speed (Marlin's junction deviation δ, `planner.cpp`): with θ the angle between the
+//! reversed incoming direction and the outgoing one (180° = straight on), `sin(θ/2) =
+//! √((1 − cos θ)/2)` and `v² = a·δ·sin(θ/2) / (1 − sin(θ/2))` — unlimited going straight, zero
+//! reversing, and barely limited by the small turns of a finely sampled curve. Klipper's
 //! square corner velocity `v₉₀` is the same rule with `δ = v₉₀²(√2 − 1)/a`.
 //!
 //! Look-ahead: a backward pass limits each entry speed so the rest of the path can still stop
@@ -41,65 +42,142 @@ pub fn trapezoid_time(len: f64, v0: f64, v1: f64, vmax: f64, a: f64) -> f64 {
 }
 
 /// Largest speed through the corner between directions `u` (in) and `w` (out), unit vectors.
+///
+/// Marlin measures θ between the reversed incoming direction and the outgoing one
+/// (`cos θ = −u·w`): going straight on is θ = 180°, so `sin(θ/2) = √((1 + u·w)/2)`.
 pub fn junction_speed(u: DVec3, w: DVec3, a: f64, deviation: f64) -> f64 {
-    let cos_theta = u.dot(w).clamp(-1.0, 1.0);
-    let sin_half = ((1.0 - cos_theta) / 2.0).max(0.0).sqrt();
-    if sin_half < 1e-9 {
-        return f64::INFINITY; // straight on
-    }
-    if sin_half > 1.0 - 1e-9 {
-        return 0.0; // reversing
-    }
-    (a * deviation * sin_half / (1.0 - sin_half)).sqrt()
+    junction_speed2(u, w, a, deviation, f64::INFINITY).sqrt()
 }
 
 /// Total time of `moves` starting at rest at `start` and ending at rest, s.
+///
+/// Works on squared speeds (no square root where a limit does not bind: on a smooth spiral at
+/// constant speed almost every junction and every pass leaves the speed at its nominal value, and
+/// such moves take `len / v` directly).
 pub fn plan_time(start: DVec3, moves: &[Move], a: f64, deviation: f64) -> f64 {
+    plan_time_of(start, moves.iter().copied(), a, deviation)
+}
+
+/// [`plan_time`] of moves given one by one (no list of them is built).
+pub fn plan_time_of(
+    start: DVec3,
+    moves: impl ExactSizeIterator<Item = Move>,
+    a: f64,
+    deviation: f64,
+) -> f64 {
     let n = moves.len();
     if n == 0 || !(a > 0.0) {
         return 0.0;
     }
+    let two_a = 2.0 * a;
     let mut len = Vec::with_capacity(n);
-    let mut dir = Vec::with_capacity(n);
+    let mut speed = Vec::with_capacity(n);
+    // entry2[i]: squared speed entering move i; entry2[n] = 0 (the job ends at rest).
+    let mut entry2 = Vec::with_capacity(n + 1);
     let mut prev = start;
+    let mut last_dir: Option<DVec3> = None;
+    let mut last_speed2 = 0.0;
+    let (mut cached_cap2, mut cached_threshold) = (f64::NAN, f64::INFINITY);
     for m in moves {
         let d = m.to - prev;
         let l = d.length();
-        len.push(l);
-        dir.push(if l > 0.0 { d / l } else { DVec3::ZERO });
-        prev = m.to;
-    }
-    // Entry speed limits: the junction with the previous (non-empty) move and both moves' speeds.
-    let mut entry = vec![0.0_f64; n + 1]; // entry[i] = speed entering move i; entry[n] = 0 (stop)
-    let mut last_dir: Option<DVec3> = None;
-    for i in 0..n {
-        if len[i] == 0.0 {
-            entry[i] = last_dir.map_or(0.0, |_| f64::INFINITY);
-            continue;
-        }
-        entry[i] = match last_dir {
-            None => 0.0,
-            Some(u) => junction_speed(u, dir[i], a, deviation)
-                .min(moves[i].speed)
-                .min(moves[i - 1].speed.max(0.0)),
+        let v2 = m.speed * m.speed;
+        let limit2 = if l == 0.0 {
+            // A move that goes nowhere passes the speed on unchanged.
+            if last_dir.is_some() {
+                f64::INFINITY
+            } else {
+                0.0
+            }
+        } else {
+            let w = d * (1.0 / l);
+            let j2 = match last_dir {
+                None => 0.0,
+                Some(u) => {
+                    let cap2 = v2.min(last_speed2);
+                    if cap2 != cached_cap2 {
+                        cached_cap2 = cap2;
+                        cached_threshold = cap_threshold(cap2, a, deviation);
+                    }
+                    // Most junctions of a smooth path turn too little for the limit to bind.
+                    let sin_half2 = (1.0 + u.dot(w).clamp(-1.0, 1.0)) / 2.0;
+                    if sin_half2 >= cached_threshold {
+                        cap2
+                    } else {
+                        junction_speed2(u, w, a, deviation, cap2)
+                    }
+                }
+            };
+            last_dir = Some(w);
+            j2
         };
-        last_dir = Some(dir[i]);
+        entry2.push(limit2.min(v2).min(if l == 0.0 {
+            f64::INFINITY
+        } else {
+            last_speed2.max(v2)
+        }));
+        len.push(l);
+        speed.push(m.speed);
+        prev = m.to;
+        if l > 0.0 {
+            last_speed2 = v2;
+        }
     }
-    for i in 0..n {
-        entry[i] = entry[i].min(moves[i].speed);
-    }
-    entry[n] = 0.0;
+    entry2.push(0.0);
     // Backward pass: every move can still slow down to the next entry speed.
     for i in (0..n).rev() {
-        entry[i] = entry[i].min((entry[i + 1] * entry[i + 1] + 2.0 * a * len[i]).sqrt());
+        let reach = entry2[i + 1] + two_a * len[i];
+        if entry2[i] > reach {
+            entry2[i] = reach;
+        }
     }
     // Forward pass: acceleration from the previous entry limits this one.
     for i in 0..n {
-        entry[i + 1] = entry[i + 1].min((entry[i] * entry[i] + 2.0 * a * len[i]).sqrt());
+        let reach = entry2[i] + two_a * len[i];
+        if entry2[i + 1] > reach {
+            entry2[i + 1] = reach;
+        }
     }
-    (0..n)
-        .map(|i| trapezoid_time(len[i], entry[i], entry[i + 1], moves[i].speed, a))
-        .sum()
+    let mut total = 0.0;
+    let (mut v_last, mut inv_v) = (f64::NAN, 0.0);
+    for i in 0..n {
+        let v = speed[i];
+        if v != v_last {
+            (v_last, inv_v) = (v, 1.0 / v);
+        }
+        let v2 = v * v;
+        total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
+            len[i] * inv_v // cruising all the way
+        } else {
+            trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
+        };
+    }
+    total
+}
+
+/// The `sin²(θ/2)` above which a junction's speed limit reaches `cap2`: `v² = a·δ·s/(1 − s)`
+/// grows with `s = sin(θ/2)`, and `v² ≥ cap²` ⟺ `s ≥ k/(1 + k)` with `k = cap²/(a·δ)`.
+fn cap_threshold(cap2: f64, a: f64, deviation: f64) -> f64 {
+    let k = cap2 / (a * deviation);
+    if k.is_finite() {
+        let s_cap = k / (1.0 + k);
+        s_cap * s_cap
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// [`junction_speed`] squared, at most `cap2` (the square of the speeds on either side).
+fn junction_speed2(u: DVec3, w: DVec3, a: f64, deviation: f64, cap2: f64) -> f64 {
+    let sin_half2 = (1.0 + u.dot(w).clamp(-1.0, 1.0)) / 2.0;
+    if sin_half2 >= cap_threshold(cap2, a, deviation) {
+        return cap2;
+    }
+    let sin_half = sin_half2.sqrt();
+    if sin_half > 1.0 - 1e-9 {
+        return cap2; // straight on
+    }
+    (a * deviation * sin_half / (1.0 - sin_half)).min(cap2)
 }
 
 #[cfg(test)]
@@ -172,21 +250,49 @@ mod tests {
     }
 
     #[test]
-    fn lower_acceleration_takes_longer() {
-        let circle: Vec<Move> = (1..=400)
+    fn a_smooth_curve_runs_at_full_speed() {
+        // 4000 points round a 40 mm circle at 20 mm/s: every junction turns 0.09°, far inside
+        // the cornering limit, so only the start and the stop cost time: L/v + v/a.
+        let n = 4000;
+        let path: Vec<Move> = (1..=n)
             .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / 100.0;
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
                 Move {
-                    to: DVec3::new(40.0 * a.cos(), 40.0 * a.sin(), k as f64 * 0.01),
+                    to: DVec3::new(40.0 * a.cos(), 40.0 * a.sin(), 0.0),
                     speed: 20.0,
                 }
             })
             .collect();
+        let t = plan_time(DVec3::new(40.0, 0.0, 0.0), &path, 300.0, 0.013);
+        let length = n as f64 * 2.0 * 40.0 * (std::f64::consts::PI / n as f64).sin();
+        let want = length / 20.0 + 20.0 / 300.0;
+        assert!((t - want).abs() < 1e-6 * want, "{t} vs {want}");
+    }
+
+    #[test]
+    fn lower_acceleration_takes_longer() {
+        // An octagonal spiral: 45° corners every 31 mm.
+        let path: Vec<Move> = (1..=80)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 8.0;
+                Move {
+                    to: DVec3::new(40.0 * a.cos(), 40.0 * a.sin(), k as f64 * 0.1),
+                    speed: 40.0,
+                }
+            })
+            .collect();
         let start = DVec3::new(40.0, 0.0, 0.0);
-        let fast = plan_time(start, &circle, 3000.0, 0.013);
-        let slow = plan_time(start, &circle, 50.0, 0.013);
-        let length: f64 = 4.0 * std::f64::consts::TAU * 40.0;
-        assert!(fast > length / 20.0, "{fast}");
-        assert!(slow > fast * 1.05, "{slow} vs {fast}");
+        let fast = plan_time(start, &path, 3000.0, 0.013);
+        let slow = plan_time(start, &path, 50.0, 0.013);
+        let length: f64 = path
+            .iter()
+            .scan(start, |p, m| {
+                let d = p.distance(m.to);
+                *p = m.to;
+                Some(d)
+            })
+            .sum();
+        assert!(fast > length / 40.0, "{fast}");
+        assert!(slow > fast * 1.5, "{slow} vs {fast}");
     }
 }

@@ -24,7 +24,10 @@ pub fn render(points: &[DVec3], w: u32, h: u32) -> image::RgbaImage {
     }
     // View: turned 30° about the vertical, looking down 20°.
     let (yaw, pitch) = (30f64.to_radians(), 20f64.to_radians());
-    let centre = points.iter().fold(DVec3::ZERO, |a, p| a + *p) / points.len() as f64;
+    // About one point per pixel (at least a thousand) is enough to draw the vessel.
+    let step = (points.len() / ((w * h) as usize).clamp(1_000, 40_000)).max(1);
+    let drawn = points.iter().step_by(step);
+    let centre = drawn.clone().fold(DVec3::ZERO, |a, p| a + *p) / drawn.count() as f64;
     let project = |p: DVec3| -> (DVec2, f64) {
         let q = p - centre;
         let x = q.x * yaw.cos() - q.y * yaw.sin();
@@ -34,8 +37,6 @@ pub fn render(points: &[DVec3], w: u32, h: u32) -> image::RgbaImage {
     };
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     let (mut dmin, mut dmax) = (f64::INFINITY, f64::NEG_INFINITY);
-    // At most ~40 000 points are drawn: enough for 220 × 220 pixels whatever the path.
-    let step = (points.len() / 40_000).max(1);
     for p in points.iter().step_by(step) {
         let (s, d) = project(*p);
         lo = lo.min(s);
