@@ -66,7 +66,7 @@ pub fn plan_time_of(
     deviation: f64,
 ) -> f64 {
     let n = moves.len();
-    if n == 0 || !(a > 0.0) {
+    if n == 0 || a.is_nan() || a <= 0.0 {
         return 0.0;
     }
     let two_a = 2.0 * a;
