@@ -449,6 +449,26 @@ fn check_rejects_files_that_are_not_gcode() {
     );
 }
 
+/// A reader that stops early (`clayloft printers | head -1`) is no reason to panic.
+#[cfg(unix)]
+#[test]
+fn output_into_a_closed_pipe_is_quiet() {
+    let out = Command::new("sh")
+        .args([
+            "-c",
+            "\"$0\" info | head -c 0; sleep 0.2",
+            env!("CARGO_BIN_EXE_clayloft"),
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(
+        !text(&out.stderr).contains("panicked"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
 /// Hostile numbers: violations (exit 1) or bad input (exit 2), never a hang.
 #[test]
 fn check_is_bounded_whatever_the_numbers() {
