@@ -387,8 +387,10 @@ pub fn write_program(
         let _ = writeln!(head, "; {f}");
     }
     if p.host_metadata {
-        // The forms printer hosts read: Cura's (OctoPrint plugins, Cura-format readers, printer
-        // screens) and PrusaSlicer's (its G-code viewer, Moonraker's PrusaSlicer parser).
+        // The forms printer hosts read: Cura's (`;TIME:`, `;LAYER:`: OctoPrint's plugins, printer
+        // screens) and PrusaSlicer's (its G-code viewer). Moonraker reads these only from the
+        // slicers it identifies (metadata.py SUPPORTED_SLICERS), not from Clayloft; Mainsail and
+        // Fluidd get the layers from SET_PRINT_STATS_INFO (Klipper dialect) and progress from M73.
         let _ = writeln!(
             head,
             ";FLAVOR:{}",

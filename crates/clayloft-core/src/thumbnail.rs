@@ -1,8 +1,8 @@
 //! A small picture of the vessel for the G-code header, drawn without a window (so headless
 //! `clayloft gcode` writes it): the toolpath seen from the front and a little above, every
 //! point a dot, nearer and higher dots lighter, clay-coloured on a transparent background. Written
-//! as PrusaSlicer's thumbnail block, which OctoPrint (its thumbnail plugins), Moonraker
-//! (Mainsail, Fluidd) and printer screens read:
+//! as PrusaSlicer's thumbnail block (the form OctoPrint's thumbnail plugins and printer screens
+//! read; Moonraker's parser reads it only in files of slicers it identifies):
 //!
 //! ```text
 //! ; thumbnail begin 32x32 1234
