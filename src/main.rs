@@ -8,7 +8,6 @@ mod flow;
 mod printer;
 mod screenshot;
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

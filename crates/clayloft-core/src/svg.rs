@@ -23,7 +23,15 @@ pub enum SvgError {
     NoSuchId(String),
     #[error("the drawing has no closed path")]
     NoClosedPath,
+    #[error(
+        "the drawing's paths flatten to more than {MAX_FLAT_POINTS} points before a closed one is found: simplify it"
+    )]
+    TooComplex,
 }
+
+/// Most points all flattened paths of a drawing may give: far beyond any outline a vessel needs
+/// (designs sample at most 100 000 points), and a bound on time and memory for any file.
+pub const MAX_FLAT_POINTS: usize = 2_000_000;
 
 /// Reads an SVG file (at most [`MAX_BYTES`]) into a tree.
 pub fn load_svg(path: &std::path::Path) -> Result<usvg::Tree, SvgError> {
@@ -68,12 +76,18 @@ pub fn closed_outline(tree: &usvg::Tree, id: Option<&str>) -> Result<Vec<DVec2>,
                 .iter()
                 .find(|p| p.id() == id)
                 .ok_or_else(|| SvgError::NoSuchId(id.into()))?;
-            first_closed(p, tol).ok_or(SvgError::NoClosedPath)
+            let mut budget = MAX_FLAT_POINTS;
+            first_closed(p, tol, &mut budget)?.ok_or(SvgError::NoClosedPath)
         }
-        None => paths
-            .iter()
-            .find_map(|p| first_closed(p, tol))
-            .ok_or(SvgError::NoClosedPath),
+        None => {
+            let mut budget = MAX_FLAT_POINTS;
+            for p in &paths {
+                if let Some(outline) = first_closed(p, tol, &mut budget)? {
+                    return Ok(outline);
+                }
+            }
+            Err(SvgError::NoClosedPath)
+        }
     }
 }
 
@@ -88,7 +102,12 @@ fn collect_paths<'a>(group: &'a usvg::Group, out: &mut Vec<&'a usvg::Path>) {
 }
 
 /// Flattens the first sub-path ending in `Close` (or returning to its start) of a path.
-fn first_closed(path: &usvg::Path, tol: f64) -> Option<Vec<DVec2>> {
+/// `budget`: points all paths may still give ([`MAX_FLAT_POINTS`] in all).
+fn first_closed(
+    path: &usvg::Path,
+    tol: f64,
+    budget: &mut usize,
+) -> Result<Option<Vec<DVec2>>, SvgError> {
     let t = path.abs_transform();
     let map = |p: usvg::tiny_skia_path::Point| {
         let mut q = p;
@@ -98,10 +117,11 @@ fn first_closed(path: &usvg::Path, tol: f64) -> Option<Vec<DVec2>> {
     let mut pts: Vec<DVec2> = Vec::new();
     let mut last = DVec2::ZERO;
     for seg in path.data().segments() {
+        let before = pts.len();
         match seg {
             PathSegment::MoveTo(p) => {
                 if closes(&pts) {
-                    return Some(pts);
+                    return Ok(Some(pts));
                 }
                 pts.clear();
                 last = map(p);
@@ -144,12 +164,17 @@ fn first_closed(path: &usvg::Path, tol: f64) -> Option<Vec<DVec2>> {
             }
             PathSegment::Close => {
                 if pts.len() >= 3 {
-                    return Some(pts);
+                    return Ok(Some(pts));
                 }
             }
         }
+        let added = pts.len().saturating_sub(before).max(1);
+        if added > *budget {
+            return Err(SvgError::TooComplex);
+        }
+        *budget -= added;
     }
-    closes(&pts).then_some(pts)
+    Ok(closes(&pts).then_some(pts))
 }
 
 /// A sub-path that ends where it began is closed even without `Z`.
@@ -228,6 +253,25 @@ mod tests {
         let h = mm.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max)
             - mm.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
         assert!((h - 40.0).abs() < 1e-6, "{h}");
+    }
+
+    #[test]
+    fn a_drawing_of_millions_of_curves_is_refused_not_flattened_forever() {
+        // 2000 open cubic curves, each flattened to 4096 points: 8 M points, past the budget.
+        let mut d = String::from("M 0 0");
+        for k in 0..2000 {
+            d += &format!(
+                " C {} 1e9 {} -1e9 {} 0",
+                k * 10 + 3,
+                k * 10 + 6,
+                k * 10 + 10
+            );
+        }
+        let svg = format!(
+            "<svg xmlns='http://www.w3.org/2000/svg' width='100' height='100'><path d='{d}'/></svg>"
+        );
+        let tree = parse_svg(svg.as_bytes()).unwrap();
+        assert_eq!(closed_outline(&tree, None), Err(SvgError::TooComplex));
     }
 
     #[test]
