@@ -846,4 +846,27 @@ mod tests {
         assert_eq!(texture.x.map(|w| w.period), Some(20.0));
         assert!(clayloft_core::run(h.state()).is_ok());
     }
+
+    #[test]
+    fn a_printer_is_picked_from_the_form_and_the_design_prints_on_it() {
+        let mut h = form();
+        h.get_by_label("Printer").click(); // open the section
+        h.run();
+        h.get_by_value("custom").click(); // the picker shows the design's printer
+        h.run();
+        h.get_by_label("wasp-2040-clay").click();
+        h.run();
+        let p = &h.state().printer;
+        assert_eq!(p.profile.as_deref(), Some("wasp-2040-clay"));
+        assert_eq!(p.bed_shape, clayloft_core::design::BedShape::Circle);
+        assert_eq!((p.bed_x, p.bed_y), (200.0, 200.0));
+        assert!(
+            h.query_by_label_contains("round bed 200 mm across, origin centre")
+                .is_some()
+        );
+        // The vessel stands at the centre of the round bed and prints there.
+        assert_eq!(h.state().center(), [100.0, 100.0]);
+        let job = clayloft_core::run(h.state()).expect("the design prints on the delta");
+        assert!(!job.toolpath.points.is_empty());
+    }
 }
