@@ -87,7 +87,12 @@ pub fn print(file: &Path, port: &str, baud: u32, timeout_s: f64) -> Result<ExitC
             } else {
                 format!(" (last message: {last_message})")
             };
-            eprintln!("error: {port}: {why}{extra}");
+            // The link's port errors name the port already.
+            if why.starts_with(port) {
+                eprintln!("error: {why}{extra}");
+            } else {
+                eprintln!("error: {port}: {why}{extra}");
+            }
             Ok(ExitCode::from(1))
         }
         other => {

@@ -65,8 +65,9 @@ pub fn run_job(
         let outgoing: Vec<Vec<u8>> = sender.outgoing().collect();
         for bytes in outgoing {
             if let Err(e) = port.write_all(&bytes).and_then(|_| port.flush()) {
+                // The same words as a failed read: it is the same fault, seen on the other side.
                 sender.receive_port_error(&format!(
-                    "{name}: cannot write: {e} (was the printer unplugged?)"
+                    "{name}: the port went away: cannot write: {e} (was the printer unplugged?)"
                 ));
             }
         }
