@@ -235,7 +235,7 @@ fn job_of(path: &Path, printer: Option<&str>) -> Result<(LoadedDesign, PrintJob)
 
 /// `clayloft printers`: the shipped profiles, one line each.
 fn printers() -> Result<ExitCode, Failure> {
-    use clayloft_core::design::{BedShape, Dialect, Origin};
+    use clayloft_core::design::BedShape;
     println!(
         "{:<22} {:<40} {:<22} {:<7} {:<15} kinematics",
         "profile", "printer", "bed", "origin", "firmware"
@@ -247,18 +247,12 @@ fn printers() -> Result<ExitCode, Failure> {
             BedShape::Rectangle => format!("{} x {} x {} mm", p.bed_x, p.bed_y, p.max_z),
             BedShape::Circle => format!("round {} x {} mm", p.bed_x, p.max_z),
         };
-        let origin = match p.origin {
-            Origin::Corner => "corner",
-            Origin::Centre => "centre",
-        };
-        let dialect = match p.dialect {
-            Dialect::Marlin => "marlin",
-            Dialect::Klipper => "klipper",
-            Dialect::RepRapFirmware => "reprapfirmware",
-        };
         println!(
-            "{name:<22} {:<40} {bed:<22} {origin:<7} {dialect:<15} {:?}",
-            file.name, p.kinematics
+            "{name:<22} {:<40} {bed:<22} {:<7} {:<15} {}",
+            file.name,
+            p.origin.name(),
+            p.dialect.title(),
+            p.kinematics.name()
         );
     }
     Ok(ExitCode::SUCCESS)

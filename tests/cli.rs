@@ -5,27 +5,11 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn clayloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_clayloft"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run clayloft")
-}
+mod common;
+use common::{clayloft, text, toml_files};
 
 fn designs() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    v.sort();
-    v
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
+    toml_files("assets/designs")
 }
 
 /// Asserts the bad-input contract: exit 2, one line on stderr that names `needle`, no panic.

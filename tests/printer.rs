@@ -3,8 +3,11 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+mod common;
+use common::wait_bounded;
 
 const BIN: &str = env!("CARGO_BIN_EXE_clayloft");
 
@@ -22,21 +25,6 @@ fn fake_printer(args: &[&str]) -> (Child, String) {
         .read_line(&mut port)
         .unwrap();
     (child, port.trim().to_string())
-}
-
-/// Waits for a process at most `limit`; a hang is a test failure, not a stuck CI.
-fn wait_bounded(mut child: Child, limit: Duration) -> Output {
-    let start = Instant::now();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            return child.wait_with_output().unwrap();
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            panic!("no exit within {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
 }
 
 fn print(file: &Path, port: &str) -> Child {

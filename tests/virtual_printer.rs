@@ -9,8 +9,11 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+mod common;
+use common::wait_bounded;
 
 const BIN: &str = env!("CARGO_BIN_EXE_clayloft");
 
@@ -56,24 +59,6 @@ fn virtual_printer(events: &Path, resend_ratio: u32) -> (Child, String) {
         "no port from the virtual printer"
     );
     (child, port.trim().to_string())
-}
-
-fn wait_bounded(mut child: Child, limit: Duration) -> Output {
-    let start = Instant::now();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            return child.wait_with_output().unwrap();
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let out = child.wait_with_output().unwrap();
-            panic!(
-                "no exit within {limit:?}: {}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
 }
 
 /// The commands of a G-code file as the sender numbers them (comments and blank lines gone).

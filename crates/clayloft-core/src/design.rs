@@ -101,6 +101,21 @@ pub enum BedShape {
 }
 
 impl BedShape {
+    /// As written in design and profile files (and G-code headers).
+    pub fn name(self) -> &'static str {
+        match self {
+            BedShape::Rectangle => "rectangle",
+            BedShape::Circle => "circle",
+        }
+    }
+
+    /// The shape a file calls `name`.
+    pub fn from_name(name: &str) -> Option<BedShape> {
+        [BedShape::Rectangle, BedShape::Circle]
+            .into_iter()
+            .find(|b| b.name() == name)
+    }
+
     /// True when the bed-frame point (x, y) lies on a bed of this shape, `bed_x` × `bed_y`
     /// (a round bed is `bed_x` across), within `eps`.
     pub fn contains(self, bed_x: f64, bed_y: f64, x: f64, y: f64, eps: f64) -> bool {
@@ -128,6 +143,24 @@ pub enum Origin {
 }
 
 impl Origin {
+    /// As written in design and profile files (and G-code headers).
+    pub fn name(self) -> &'static str {
+        match self {
+            Origin::Corner => "corner",
+            Origin::Centre => "centre",
+        }
+    }
+
+    /// The origin a file calls `name` (`"center"` too, as the design files accept it).
+    pub fn from_name(name: &str) -> Option<Origin> {
+        match name {
+            "center" => Some(Origin::Centre),
+            _ => [Origin::Corner, Origin::Centre]
+                .into_iter()
+                .find(|o| o.name() == name),
+        }
+    }
+
     /// Where this origin lies in the bed frame of a `bed_x` × `bed_y` bed.
     pub fn offset(self, bed_x: f64, bed_y: f64) -> [f64; 2] {
         match self {
@@ -155,6 +188,38 @@ pub enum Dialect {
     Marlin,
     Klipper,
     RepRapFirmware,
+}
+
+impl Dialect {
+    /// The firmware's own name, for people (headers, lists).
+    pub fn title(self) -> &'static str {
+        match self {
+            Dialect::Marlin => "Marlin",
+            Dialect::Klipper => "Klipper",
+            Dialect::RepRapFirmware => "RepRapFirmware",
+        }
+    }
+}
+
+impl Kinematics {
+    /// As written in design and profile files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kinematics::Cartesian => "cartesian",
+            Kinematics::Delta => "delta",
+            Kinematics::Scara => "scara",
+        }
+    }
+}
+
+impl ExtrusionMode {
+    /// The G-code that puts the firmware in this mode.
+    pub fn gcode(self) -> &'static str {
+        match self {
+            ExtrusionMode::Relative => "M83",
+            ExtrusionMode::Absolute => "M82",
+        }
+    }
 }
 
 /// The printer and the print settings. Defaults: the paper's clay printer (Cerambot Plus class).

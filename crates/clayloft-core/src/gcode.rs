@@ -71,70 +71,33 @@ fn home_position(p: &crate::design::Printer) -> DVec3 {
 fn planned_moves<'a>(
     design: &Design,
     tp: &'a Toolpath,
-) -> (DVec3, impl ExactSizeIterator<Item = motion::Move> + 'a) {
+) -> (DVec3, impl Iterator<Item = motion::Move> + 'a) {
     let p = &design.printer;
     let (z_in, z_out) = clearance_heights(design, tp);
     let home = home_position(p);
     let travel = p.travel_speed;
-    let mut ends: Vec<motion::Move> = Vec::new();
-    let mut exit: Vec<motion::Move> = Vec::new();
-    if let (Some(f), Some(l)) = (tp.points.first(), tp.points.last()) {
-        ends.push(motion::Move {
-            to: DVec3::new(home.x, home.y, z_in),
-            speed: travel,
-        });
-        ends.push(motion::Move {
-            to: DVec3::new(f.pos.x, f.pos.y, z_in),
-            speed: travel,
-        });
-        ends.push(motion::Move {
-            to: f.pos,
-            speed: travel,
-        });
-        exit.push(motion::Move {
-            to: DVec3::new(l.pos.x, l.pos.y, z_out),
-            speed: travel,
-        });
-    }
+    let at = |to: DVec3| motion::Move { to, speed: travel };
+    let (approach, exit) = match (tp.points.first(), tp.points.last()) {
+        (Some(f), Some(l)) => (
+            vec![
+                at(DVec3::new(home.x, home.y, z_in)),
+                at(DVec3::new(f.pos.x, f.pos.y, z_in)),
+                at(f.pos),
+            ],
+            Some(at(DVec3::new(l.pos.x, l.pos.y, z_out))),
+        ),
+        _ => (Vec::new(), None),
+    };
     let path = tp.points.get(1..).unwrap_or(&[]);
-    let n = ends.len() + path.len() + exit.len();
-    let moves = ends
+    let moves = approach
         .into_iter()
         .chain(path.iter().map(|q| motion::Move {
             to: q.pos,
             speed: q.speed,
         }))
         .chain(exit);
-    (
-        home,
-        ExactLen {
-            inner: moves,
-            left: n,
-        },
-    )
+    (home, moves)
 }
-
-/// An iterator whose length is known (chains of slices and small lists are not `ExactSize`).
-struct ExactLen<I> {
-    inner: I,
-    left: usize,
-}
-
-impl<I: Iterator> Iterator for ExactLen<I> {
-    type Item = I::Item;
-    fn next(&mut self) -> Option<I::Item> {
-        let x = self.inner.next();
-        if x.is_some() {
-            self.left -= 1;
-        }
-        x
-    }
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        (self.left, Some(self.left))
-    }
-}
-
-impl<I: Iterator> ExactSizeIterator for ExactLen<I> {}
 
 /// Length, time and volume of a job.
 pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
@@ -252,13 +215,7 @@ pub fn template_values(design: &Design, job: &PrintJob, summary: &JobSummary) ->
             "design_name",
             design.name.replace(['\n', '\r', '{', '}'], " "),
         ),
-        (
-            "e_mode",
-            match p.extrusion {
-                ExtrusionMode::Relative => "M83".into(),
-                ExtrusionMode::Absolute => "M82".into(),
-            },
-        ),
+        ("e_mode", p.extrusion.gcode().into()),
         ("travel_feed", format!("{:.0}", p.travel_speed * 60.0)),
     ]
 }
@@ -323,11 +280,7 @@ pub fn write_program(
             Origin::Corner => "at the front left corner",
             Origin::Centre => "at the bed centre",
         },
-        match p.dialect {
-            Dialect::Marlin => "Marlin",
-            Dialect::Klipper => "Klipper",
-            Dialect::RepRapFirmware => "RepRapFirmware",
-        }
+        p.dialect.title()
     );
     let _ = writeln!(
         head,
@@ -374,14 +327,8 @@ pub fn write_program(
         p.max_layer_height,
         p.nozzle_length,
         p.max_overhang_deg,
-        match p.bed_shape {
-            BedShape::Rectangle => "rectangle",
-            BedShape::Circle => "circle",
-        },
-        match p.origin {
-            Origin::Corner => "corner",
-            Origin::Centre => "centre",
-        }
+        p.bed_shape.name(),
+        p.origin.name()
     );
     for f in &job.surface.findings {
         let _ = writeln!(head, "; {f}");
@@ -426,10 +373,11 @@ pub fn write_program(
         head.push('\n');
     }
     // Whatever a custom start G-code does, the path needs absolute positions and its E mode.
-    head.push_str(match p.extrusion {
-        ExtrusionMode::Relative => "G90\nM83\nG92 E0 ; positions and E as the path needs them\n",
-        ExtrusionMode::Absolute => "G90\nM82\nG92 E0 ; positions and E as the path needs them\n",
-    });
+    let _ = writeln!(
+        head,
+        "G90\n{}\nG92 E0 ; positions and E as the path needs them",
+        p.extrusion.gcode()
+    );
     out.write_all(head.as_bytes())?;
 
     let [ox, oy] = p.origin_offset();

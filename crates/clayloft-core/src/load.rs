@@ -120,12 +120,15 @@ impl ResolveError {
     }
 }
 
-fn syntax(source: &str, e: toml::de::Error) -> ParseError {
+/// Where in `source` a TOML error is (1-based line) and its message's first line.
+fn syntax_at(source: &str, e: &toml::de::Error) -> (usize, String) {
     let line = e.span().map(|s| line_of(source, s.start)).unwrap_or(1);
-    ParseError::Syntax {
-        line,
-        message: first_line(e.message()),
-    }
+    (line, first_line(e.message()))
+}
+
+fn syntax(source: &str, e: toml::de::Error) -> ParseError {
+    let (line, message) = syntax_at(source, &e);
+    ParseError::Syntax { line, message }
 }
 
 /// Design text → a validated design: the text alone (syntax, types, unknown fields), then the
@@ -155,16 +158,16 @@ fn resolve(
         )))
     })?;
     let profile_file = found.file.display().to_string();
-    let profile: crate::profile::ProfileFile = toml::from_str(&found.text).map_err(|e| {
-        let ParseError::Syntax { line, message } = syntax(&found.text, e) else {
-            unreachable!("syntax() gives syntax errors")
-        };
+    let profile_syntax = |e: toml::de::Error| {
+        let (line, message) = syntax_at(&found.text, &e);
         ResolveError::Profile(DesignError::Syntax {
             file: profile_file.clone(),
             line,
             message,
         })
-    })?;
+    };
+    let profile: crate::profile::ProfileFile =
+        toml::from_str(&found.text).map_err(profile_syntax)?;
     let mut alone = profile.printer.clone();
     alone.normalize();
     crate::validate::validate_printer(&alone)
@@ -172,13 +175,7 @@ fn resolve(
     // The design's own [printer] fields over the profile's.
     let design_table: toml::Table =
         toml::from_str(source).map_err(|e| ResolveError::Design(syntax(source, e)))?;
-    let profile_table: toml::Table = toml::from_str(&found.text).map_err(|e| {
-        ResolveError::Profile(DesignError::Syntax {
-            file: profile_file.clone(),
-            line: 1,
-            message: first_line(e.message()),
-        })
-    })?;
+    let profile_table: toml::Table = toml::from_str(&found.text).map_err(profile_syntax)?;
     let mut merged_printer = profile_table
         .get("printer")
         .and_then(|v| v.as_table())

@@ -61,19 +61,20 @@ pub fn plan_time(start: DVec3, moves: &[Move], a: f64, deviation: f64) -> f64 {
 /// [`plan_time`] of moves given one by one (no list of them is built).
 pub fn plan_time_of(
     start: DVec3,
-    moves: impl ExactSizeIterator<Item = Move>,
+    moves: impl IntoIterator<Item = Move>,
     a: f64,
     deviation: f64,
 ) -> f64 {
-    let n = moves.len();
-    if n == 0 || a.is_nan() || a <= 0.0 {
+    if a.is_nan() || a <= 0.0 {
         return 0.0;
     }
+    let moves = moves.into_iter();
+    let hint = moves.size_hint().0;
     let two_a = 2.0 * a;
-    let mut len = Vec::with_capacity(n);
-    let mut speed = Vec::with_capacity(n);
+    let mut len = Vec::with_capacity(hint);
+    let mut speed = Vec::with_capacity(hint);
     // entry2[i]: squared speed entering move i; entry2[n] = 0 (the job ends at rest).
-    let mut entry2 = Vec::with_capacity(n + 1);
+    let mut entry2 = Vec::with_capacity(hint + 1);
     let mut prev = start;
     let mut last_dir: Option<DVec3> = None;
     let mut last_speed2 = 0.0;
@@ -123,6 +124,7 @@ pub fn plan_time_of(
             last_speed2 = v2;
         }
     }
+    let n = len.len();
     entry2.push(0.0);
     // Backward pass: every move can still slow down to the next entry speed.
     for i in (0..n).rev() {

@@ -615,20 +615,12 @@ fn printer_picker(ui: &mut egui::Ui, d: &mut Design) {
             "bed {} × {} mm, origin {}",
             p.bed_x,
             p.bed_y,
-            if p.origin == clayloft_core::design::Origin::Centre {
-                "centre"
-            } else {
-                "corner"
-            }
+            p.origin.name()
         ),
         clayloft_core::design::BedShape::Circle => format!(
             "round bed {} mm across, origin {}",
             p.bed_x,
-            if p.origin == clayloft_core::design::Origin::Centre {
-                "centre"
-            } else {
-                "corner"
-            }
+            p.origin.name()
         ),
     });
 }

@@ -1,9 +1,10 @@
 //! The limits a G-code file is checked against: from a design's printer or a Clayloft header,
-//! each within the physical range a clay printer can have (so that no header can make the
+//! each within the physical range a clay printer can have (the design validator's ranges) (so that no header can make the
 //! checker's search grid microscopic or its numbers meaningless).
 
 use crate::design::{BedShape, Origin, Printer};
 use crate::gcode::LIMITS_KEY;
+use crate::validate::validate_printer;
 
 /// The printer limits a G-code file is checked against.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,17 +34,16 @@ pub struct LimitsError {
     pub why: String,
 }
 
-/// The physical range of each limit (the design validator's ranges, `validate.rs`): lengths up
-/// to 10 m, beads 0.1 … 50 mm, layers 0.01 … 50 mm, lean 1 … 80°.
-const RANGES: [(&str, f64, f64); 8] = [
-    ("bed_x", 1.0, 10_000.0),
-    ("bed_y", 1.0, 10_000.0),
-    ("max_z", 1.0, 10_000.0),
-    ("line_width", 0.1, 50.0),
-    ("min_layer_height", 0.01, 50.0),
-    ("max_layer_height", 0.01, 50.0),
-    ("nozzle_length", 0.1, 10_000.0),
-    ("max_overhang_deg", 1.0, 80.0),
+/// The header keys of the numeric limits (the design file's `[printer]` field names).
+const KEYS: [&str; 8] = [
+    "bed_x",
+    "bed_y",
+    "max_z",
+    "line_width",
+    "min_layer_height",
+    "max_layer_height",
+    "nozzle_length",
+    "max_overhang_deg",
 ];
 
 impl From<&Printer> for Limits {
@@ -88,29 +88,40 @@ impl Limits {
         self.bed_shape.contains(self.bed_x, self.bed_y, x, y, eps)
     }
 
-    /// Every limit finite and inside its physical range, the layer range not inverted.
+    /// Every limit finite and inside its physical range, the layer range not inverted: the
+    /// design validator's own checks of these printer fields ([`validate_printer`]), so a
+    /// header and a design are held to the same ranges.
     pub fn validate(&self) -> Result<(), LimitsError> {
-        let mut copy = *self;
-        for (key, lo, hi) in RANGES {
-            let value = *copy.field(key).expect("every range names a field");
-            if !(value.is_finite() && (lo..=hi).contains(&value)) {
-                return Err(LimitsError {
-                    line: None,
-                    key,
-                    value,
-                    why: format!("outside {lo} ..= {hi}, what a clay printer can have"),
-                });
-            }
-        }
-        if self.max_layer_height < self.min_layer_height {
-            return Err(LimitsError {
+        let printer = Printer {
+            bed_x: self.bed_x,
+            bed_y: self.bed_y,
+            bed_shape: self.bed_shape,
+            bed_diameter: (self.bed_shape == BedShape::Circle).then_some(self.bed_x),
+            origin: self.origin,
+            max_z: self.max_z,
+            line_width: self.line_width,
+            layer_height: self.min_layer_height,
+            min_layer_height: self.min_layer_height,
+            max_layer_height: self.max_layer_height,
+            nozzle_length: self.nozzle_length,
+            max_overhang_deg: self.max_overhang_deg,
+            ..Printer::default()
+        };
+        validate_printer(&printer).map_err(|e| {
+            let name = e.field.strip_prefix("printer.").unwrap_or(&e.field);
+            let key = KEYS
+                .iter()
+                .copied()
+                .find(|k| *k == name)
+                .unwrap_or("limits");
+            let mut copy = *self;
+            LimitsError {
                 line: None,
-                key: "max_layer_height",
-                value: self.max_layer_height,
-                why: format!("below min_layer_height={}", self.min_layer_height),
-            });
-        }
-        Ok(())
+                key,
+                value: copy.field(key).map_or(f64::NAN, |v| *v),
+                why: e.message,
+            }
+        })
     }
 
     /// Limits written in a Clayloft header (`; clayloft-limits: bed_x=… …` in the first 200
@@ -130,22 +141,20 @@ impl Limits {
             let Some((k, v)) = kv.split_once('=') else {
                 continue;
             };
-            match (k, v) {
-                ("bed_shape", "circle") => l.bed_shape = BedShape::Circle,
-                ("bed_shape", "rectangle") => l.bed_shape = BedShape::Rectangle,
-                ("origin", "centre" | "center") => l.origin = Origin::Centre,
-                ("origin", "corner") => l.origin = Origin::Corner,
-                ("bed_shape" | "origin", _) => {
-                    return Err(LimitsError {
-                        line: Some(index + 1),
-                        key: if k == "origin" { "origin" } else { "bed_shape" },
-                        value: f64::NAN,
-                        why: format!("`{}` is not a known value", truncated(v)),
-                    });
+            let unknown = |key: &'static str| LimitsError {
+                line: Some(index + 1),
+                key,
+                value: f64::NAN,
+                why: format!("`{}` is not a known value", truncated(v)),
+            };
+            match k {
+                "bed_shape" => {
+                    l.bed_shape = BedShape::from_name(v).ok_or_else(|| unknown("bed_shape"))?
                 }
+                "origin" => l.origin = Origin::from_name(v).ok_or_else(|| unknown("origin"))?,
                 _ => {}
             }
-            let Some((key, _, _)) = RANGES.iter().find(|(name, _, _)| *name == k) else {
+            let Some(key) = KEYS.iter().copied().find(|name| *name == k) else {
                 continue; // a key of a later version
             };
             let value = v.parse::<f64>().map_err(|_| LimitsError {
