@@ -74,20 +74,20 @@ fn gcode_writing(c: &mut Criterion) {
         })
         .collect();
     let job = PrintJob {
-        surface: Surface {
+        surface: std::sync::Arc::new(Surface {
             sections: Vec::new(),
             layers: 300,
             layer_pitch: 0.5,
             center: DVec2::new(90.0, 95.0),
             findings: Vec::new(),
             metrics: Default::default(),
-        },
-        toolpath: Toolpath {
+        }),
+        toolpath: std::sync::Arc::new(Toolpath {
             points,
             base_points: 0,
             revolutions: 1,
             layer_starts: vec![0],
-        },
+        }),
     };
     let mut buf = Vec::with_capacity(64 << 20);
     write_gcode(&design, &job, &mut buf).unwrap();

@@ -15,7 +15,8 @@
 //!    as firmware plans it; [`stl`] meshes the wall; [`check`] re-measures any G-code file
 //!    against the printer's limits.
 //!
-//! [`pipeline`] is the loop over these stages.
+//! [`pipeline`] is the loop over these stages; [`session`] runs them incrementally, redoing only
+//! what an edit changed.
 pub mod align;
 pub mod atomic;
 pub mod check;
@@ -35,6 +36,7 @@ pub mod profile;
 pub mod report;
 pub mod sample;
 pub mod section;
+pub mod session;
 pub mod shape;
 pub mod spline;
 pub mod stl;
@@ -49,3 +51,4 @@ pub mod validate;
 pub use design::Design;
 pub use load::{DesignError, LoadedDesign, load_design};
 pub use pipeline::{PrintJob, run};
+pub use session::Session;

@@ -1,6 +1,8 @@
 //! The whole pipeline as one loop over the per-stage functions: design → loft → control lines →
-//! constraints → texture → spiral toolpath. The app calls the same stage functions for the
-//! sections an edit touches.
+//! constraints → texture → spiral toolpath. [`crate::session::Session`] runs them
+//! incrementally; [`run`] is its first update.
+
+use std::sync::Arc;
 
 use glam::DVec2;
 
@@ -11,11 +13,12 @@ use crate::report::{Finding, FindingKind, group_events};
 use crate::section::Section;
 use crate::shape::{LIMIT_MARGIN, ShapeModel};
 use crate::texture::apply_texture;
-use crate::toolpath::{Toolpath, build_toolpath};
+use crate::session::Session;
+use crate::toolpath::Toolpath;
 use crate::validate::FieldError;
 
 /// The corrected, textured section surface of a design.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Surface {
     /// Sections 0 ..= L; section 0 is the bed contact at z = 0.
     pub sections: Vec<Section>,
@@ -27,11 +30,12 @@ pub struct Surface {
     pub metrics: SurfaceMetrics,
 }
 
-/// A design turned into a printable job.
+/// A design turned into a printable job. Shared, not copied: the app's view, the replay, the
+/// exports and the printer read the same job the [`crate::session::Session`] computed.
 #[derive(Debug, Clone)]
 pub struct PrintJob {
-    pub surface: Surface,
-    pub toolpath: Toolpath,
+    pub surface: Arc<Surface>,
+    pub toolpath: Arc<Toolpath>,
 }
 
 /// `tan(max_overhang)` with the pipeline's safety margin.
@@ -191,9 +195,10 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
     Ok(())
 }
 
-/// Runs the whole pipeline: surface, then the single spiral toolpath.
+/// Runs the whole pipeline (a fresh [`Session`]'s first update): the design validated, the
+/// surface, then the single spiral toolpath.
 pub fn run(design: &Design) -> Result<PrintJob, FieldError> {
-    let surface = build_surface(design)?;
-    let toolpath = build_toolpath(design, &surface)?;
-    Ok(PrintJob { surface, toolpath })
+    let mut session = Session::new();
+    session.update(design)?;
+    Ok(session.job().expect("a successful update has a job"))
 }

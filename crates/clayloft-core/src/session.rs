@@ -1,0 +1,643 @@
+//! The incremental engine (SPEC §8): a [`Session`] keeps the output of every pipeline stage
+//! together with the inputs it was computed from, and [`Session::update`] recomputes only the
+//! stages whose inputs changed.
+//!
+//! Each stage declares its inputs as a small value ([`ContourKey`], [`PlanKey`], [`SectionKey`],
+//! [`SurfaceKey`], [`ToolpathKey`]) built from the design and from the revisions of the stages
+//! before it; a stage runs again exactly when its key differs from the one it was last computed
+//! with. There is no hand-written list of what an edit invalidates: a field a stage does not put
+//! in its key cannot make it run, and a field it reads but forgets is caught by the test that
+//! edits designs at random and compares every update with a fresh batch run.
+//!
+//! The stages, in order:
+//! 1. each contour: built, aligned on the centre, sampled (`loft::sample_contour`);
+//! 2. the plan: loft, horizontal control lines and the layer count (`ShapeModel::new`);
+//! 3. each section k: loft plus the vertical control lines active at its height
+//!    (`ShapeModel::section`), in parallel on the machine's cores;
+//! 4. the surface: overhang correction, texture, metrics, fit on the machine
+//!    (`pipeline::finish_surface`);
+//! 5. the toolpath: the one continuous spiral (`toolpath::build_toolpath`).
+//!
+//! The batch [`crate::run`] is a fresh session's first update.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::DVec2;
+
+use crate::control::VerticalProfile;
+use crate::design::{
+    BedShape, ContourSpec, Design, HorizontalLine, Origin, Texture, VerticalLine,
+};
+use crate::loft::{LoftInput, SampledContour, sample_contour};
+use crate::pipeline::{PrintJob, Surface, finish_surface};
+use crate::report::Finding;
+use crate::section::Section;
+use crate::shape::ShapeModel;
+use crate::toolpath::{Toolpath, build_toolpath};
+use crate::validate::{FieldError, validate};
+
+/// The two contours, in the order of [`Session::contour`].
+pub const CONTOUR_FIELDS: [&str; 2] = ["shape.lower", "shape.upper"];
+
+/// One stage's output and the key it was computed from. `revision` counts the recomputations,
+/// so that later stages can put "the output of stage X as of now" in their own keys.
+#[derive(Debug, Clone)]
+struct Stage<K, V> {
+    key: Option<K>,
+    value: Option<V>,
+    revision: u64,
+}
+
+impl<K, V> Default for Stage<K, V> {
+    fn default() -> Self {
+        Stage {
+            key: None,
+            value: None,
+            revision: 0,
+        }
+    }
+}
+
+impl<K: PartialEq, V> Stage<K, V> {
+    /// Recomputes the value when `key` differs from the last one; returns whether it ran. On an
+    /// error the stage is left empty, so the next update computes it again.
+    fn refresh(
+        &mut self,
+        key: K,
+        compute: impl FnOnce() -> Result<V, FieldError>,
+    ) -> Result<bool, FieldError> {
+        if self.value.is_some() && self.key.as_ref() == Some(&key) {
+            return Ok(false);
+        }
+        self.key = None;
+        self.value = None;
+        self.revision += 1;
+        let value = compute()?;
+        self.key = Some(key);
+        self.value = Some(value);
+        Ok(true)
+    }
+
+    fn get(&self) -> Option<&V> {
+        self.value.as_ref()
+    }
+}
+
+/// Inputs of a contour: its specification and where and how finely it is sampled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContourKey {
+    pub spec: ContourSpec,
+    pub center: DVec2,
+    pub samples: usize,
+    /// The folder image and SVG paths are relative to.
+    pub base_dir: Option<PathBuf>,
+}
+
+/// Inputs of the layer plan: the sampled contours (by revision), the height, the horizontal
+/// control lines and the printer's layer and nozzle limits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanKey {
+    pub contours: [u64; 2],
+    pub center: DVec2,
+    pub height: f64,
+    pub horizontal: Vec<HorizontalLine>,
+    pub layer_height: f64,
+    pub min_layer_height: f64,
+    pub max_layer_height: f64,
+    pub nozzle_length: f64,
+    pub enforce: bool,
+}
+
+/// Inputs of one shaped section: the plan (by revision) and the vertical control lines whose
+/// offset is not zero at the section's height (a line that adds nothing there is not an input).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionKey {
+    pub plan: u64,
+    pub lines: Vec<VerticalLine>,
+}
+
+/// Inputs of the corrected, textured surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceKey {
+    pub plan: u64,
+    /// Revision of the shaped sections as a whole (any section recomputed bumps it).
+    pub sections: u64,
+    pub texture: Option<Texture>,
+    pub enforce: bool,
+    pub max_overhang_deg: f64,
+    /// The fit on the machine.
+    pub line_width: f64,
+    pub bed: (BedShape, f64, f64, Origin),
+    pub max_z: f64,
+    pub center_given: bool,
+}
+
+/// Inputs of the spiral toolpath.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ToolpathKey {
+    pub surface: u64,
+    pub base_layers: usize,
+    pub line_width: f64,
+    pub min_layer_height: f64,
+    pub max_layer_height: f64,
+    pub min_layer_time: f64,
+    pub print_speed: f64,
+    pub flow_ramp: (f64, f64),
+}
+
+/// What one [`Session::update`] recomputed.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Update {
+    /// The contours resampled, as their design fields (`shape.lower`, `shape.upper`).
+    pub contours: Vec<&'static str>,
+    /// The loft and layer plan were rebuilt.
+    pub plan: bool,
+    /// The sections reshaped, ascending.
+    pub sections: Vec<usize>,
+    /// Overhang correction, texture, metrics and the fit on the machine were redone.
+    pub surface: bool,
+    /// The spiral toolpath was rebuilt.
+    pub toolpath: bool,
+}
+
+impl Update {
+    /// True when nothing was recomputed.
+    pub fn is_nothing(&self) -> bool {
+        *self == Update::default()
+    }
+}
+
+/// The incremental engine: the cached stages of one design being edited.
+#[derive(Debug, Clone, Default)]
+pub struct Session {
+    contours: [Stage<ContourKey, SampledContour>; 2],
+    plan: Stage<PlanKey, (ShapeModel, Vec<Finding>)>,
+    sections: Vec<Stage<SectionKey, Section>>,
+    /// Bumped whenever any section is recomputed or the section count changes.
+    sections_revision: u64,
+    surface: Stage<SurfaceKey, Arc<Surface>>,
+    toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
+    /// The design and job of the last successful update.
+    design: Option<Design>,
+    job: Option<PrintJob>,
+    /// The error of the last update, if it failed.
+    error: Option<FieldError>,
+    updates: u64,
+}
+
+impl Session {
+    pub fn new() -> Session {
+        Session::default()
+    }
+
+    /// Brings every stage up to date with `design`, recomputing only the stages whose inputs
+    /// changed, and says what it recomputed. On an error (an invalid value, a vessel off the
+    /// bed) the stages that did succeed keep their new outputs, [`Session::job`] keeps the last
+    /// complete job, and [`Session::is_current`] is false until an update succeeds.
+    pub fn update(&mut self, design: &Design) -> Result<Update, FieldError> {
+        self.updates += 1;
+        let result = self.update_stages(design);
+        match &result {
+            Ok(_) => {
+                self.error = None;
+                self.job = Some(PrintJob {
+                    surface: self.surface.get().expect("updated").clone(),
+                    toolpath: self.toolpath.get().expect("updated").clone(),
+                });
+                if self.design.as_ref() != Some(design)
+                    || self.design.as_ref().map(|d| &d.base_dir) != Some(&design.base_dir)
+                {
+                    self.design = Some(design.clone());
+                }
+            }
+            Err(e) => self.error = Some(e.clone()),
+        }
+        result
+    }
+
+    fn update_stages(&mut self, design: &Design) -> Result<Update, FieldError> {
+        validate(design)?;
+        let mut done = Update::default();
+        let [cx, cy] = design.center();
+        let center = DVec2::new(cx, cy);
+
+        // 1. Contours.
+        let specs = [&design.shape.lower, &design.shape.upper];
+        for (role, stage) in self.contours.iter_mut().enumerate() {
+            let key = ContourKey {
+                spec: specs[role].clone(),
+                center,
+                samples: design.shape.samples,
+                base_dir: design.base_dir.clone(),
+            };
+            let field = CONTOUR_FIELDS[role];
+            let base = design.base_dir.as_deref();
+            if stage.refresh(key, || {
+                sample_contour(specs[role], field, center, design.shape.samples, base)
+            })? {
+                done.contours.push(field);
+            }
+        }
+
+        // 2. Loft and layer plan.
+        let (lower, upper) = (&self.contours[0], &self.contours[1]);
+        let key = PlanKey {
+            contours: [lower.revision, upper.revision],
+            center,
+            height: design.shape.height,
+            horizontal: design.control.horizontal.clone(),
+            layer_height: design.printer.layer_height,
+            min_layer_height: design.printer.min_layer_height,
+            max_layer_height: design.printer.max_layer_height,
+            nozzle_length: design.printer.nozzle_length,
+            enforce: design.constraints.enforce,
+        };
+        done.plan = self.plan.refresh(key, || {
+            let (Some(lo), Some(up)) = (lower.get(), upper.get()) else {
+                unreachable!("the contour stages ran above")
+            };
+            let loft = LoftInput::from_samples(lo.samples.clone(), up.samples.clone(), center);
+            // The vertical lines are the sections' inputs: the plan does not read them.
+            let mut plan_only = design.clone();
+            plan_only.control.vertical.clear();
+            ShapeModel::new(&plan_only, loft)
+        })?;
+        let plan_revision = self.plan.revision;
+        let Some((model, plan_findings)) = self.plan.value.as_mut() else {
+            unreachable!("the plan stage ran above")
+        };
+        model.vertical = design
+            .control
+            .vertical
+            .iter()
+            .map(VerticalProfile::new)
+            .collect();
+        let model = &*model;
+
+        // 3. Sections, each keyed by the lines active at its height; the dirty ones in parallel.
+        let count = model.layers + 1;
+        if self.sections.len() != count {
+            self.sections.resize_with(count, Stage::default);
+            self.sections_revision += 1;
+        }
+        let mut dirty = Vec::new();
+        for (k, stage) in self.sections.iter_mut().enumerate() {
+            let t = k as f64 / model.layers as f64;
+            let lines: Vec<VerticalLine> = design
+                .control
+                .vertical
+                .iter()
+                .zip(&model.vertical)
+                .filter(|(_, profile)| profile.offset_at(t) != 0.0)
+                .map(|(line, _)| line.clone())
+                .collect();
+            let key = SectionKey {
+                plan: plan_revision,
+                lines,
+            };
+            if stage.value.is_none() || stage.key.as_ref() != Some(&key) {
+                stage.key = Some(key);
+                stage.revision += 1;
+                dirty.push(k);
+            }
+        }
+        if !dirty.is_empty() {
+            let shaped = shape_sections(model, &dirty);
+            for (&k, section) in dirty.iter().zip(shaped) {
+                self.sections[k].value = Some(section);
+            }
+            self.sections_revision += 1;
+        }
+        done.sections = dirty;
+
+        // 4. Surface.
+        let p = &design.printer;
+        let key = SurfaceKey {
+            plan: plan_revision,
+            sections: self.sections_revision,
+            texture: design.texture.clone(),
+            enforce: design.constraints.enforce,
+            max_overhang_deg: p.max_overhang_deg,
+            line_width: p.line_width,
+            bed: (p.bed_shape, p.bed_x, p.bed_y, p.origin),
+            max_z: p.max_z,
+            center_given: design.shape.center.is_some(),
+        };
+        let sections = &self.sections;
+        done.surface = self.surface.refresh(key, || {
+            let shaped: Vec<Section> = sections
+                .iter()
+                .map(|s| s.value.clone().unwrap_or_default())
+                .collect();
+            finish_surface(design, model, shaped, plan_findings.clone()).map(Arc::new)
+        })?;
+
+        // 5. Toolpath.
+        let key = ToolpathKey {
+            surface: self.surface.revision,
+            base_layers: design.shape.base_layers,
+            line_width: p.line_width,
+            min_layer_height: p.min_layer_height,
+            max_layer_height: p.max_layer_height,
+            min_layer_time: p.min_layer_time,
+            print_speed: p.print_speed,
+            flow_ramp: (p.flow_ramp_start, p.flow_ramp_end),
+        };
+        let surface = self.surface.get().cloned();
+        done.toolpath = self.toolpath.refresh(key, || {
+            let surface = surface.expect("the surface stage ran above");
+            build_toolpath(design, &surface).map(Arc::new)
+        })?;
+        Ok(done)
+    }
+
+    /// The current job (the last complete one if the last update failed).
+    pub fn job(&self) -> Option<PrintJob> {
+        self.job.clone()
+    }
+
+    /// The design the current job was computed from.
+    pub fn design(&self) -> Option<&Design> {
+        self.design.as_ref()
+    }
+
+    /// True when the last update succeeded: the outputs are the current design's.
+    pub fn is_current(&self) -> bool {
+        self.error.is_none() && self.design.is_some()
+    }
+
+    /// The last update's error.
+    pub fn error(&self) -> Option<&FieldError> {
+        self.error.as_ref()
+    }
+
+    /// Updates so far.
+    pub fn updates(&self) -> u64 {
+        self.updates
+    }
+
+    /// The sampled contour `role` (0 lower, 1 upper; see [`CONTOUR_FIELDS`]).
+    pub fn contour(&self, role: usize) -> Option<&SampledContour> {
+        self.contours.get(role)?.get()
+    }
+
+    /// The shape model (loft, control profiles, layer plan) of the current design.
+    pub fn model(&self) -> Option<&ShapeModel> {
+        self.plan.get().map(|(m, _)| m)
+    }
+
+    /// Shaped section k (loft and control lines, before correction and texture).
+    pub fn shaped_section(&self, k: usize) -> Option<&Section> {
+        self.sections.get(k)?.get()
+    }
+
+    /// The corrected, textured surface.
+    pub fn surface(&self) -> Option<&Arc<Surface>> {
+        self.surface.get()
+    }
+
+    /// The spiral toolpath.
+    pub fn toolpath(&self) -> Option<&Arc<Toolpath>> {
+        self.toolpath.get()
+    }
+}
+
+/// Below this many wall points a section batch is shaped on one thread (spawning costs more).
+const PARALLEL_POINTS: usize = 20_000;
+
+/// Shapes the sections `ks` of `model`, split over the machine's cores when there is enough work.
+fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<Section> {
+    let work = ks.len() * model.loft.samples();
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(ks.len());
+    if threads < 2 || work < PARALLEL_POINTS {
+        return ks.iter().map(|&k| model.section(k)).collect();
+    }
+    let chunk = ks.len().div_ceil(threads);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = ks
+            .chunks(chunk)
+            .map(|part| {
+                scope.spawn(move || part.iter().map(|&k| model.section(k)).collect::<Vec<_>>())
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join()
+                    .unwrap_or_else(|e: Box<dyn std::any::Any + Send>| std::panic::resume_unwind(e))
+            })
+            .collect::<Vec<Section>>()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::{ContourSpec, VerticalLine};
+    use crate::load::parse_design;
+    use proptest::prelude::*;
+
+    /// A small design with every kind of input: two contours, a global and a local vertical
+    /// line, a horizontal line, a texture and a base.
+    fn design() -> Design {
+        parse_design(
+            r#"
+version = 1
+[shape]
+height = 30.0
+samples = 48
+base_layers = 2
+lower = { type = "circle", radius = 25.0 }
+upper = { type = "ellipse", rx = 30.0, ry = 22.0 }
+[[control.vertical]]
+points = [[0.0, 0.0], [0.5, 3.0], [1.0, 0.0]]
+[[control.vertical]]
+points = [[0.0, 0.0], [0.3, 0.0], [0.5, 4.0], [0.7, 0.0], [1.0, 0.0]]
+angle = 90.0
+width = 60.0
+[[control.horizontal]]
+at = 1.0
+reach = 0.3
+points = [[0.0, 1.0], [180.0, -1.0]]
+[texture]
+x = { wave = "sine", period = 10.0, amplitude = 0.8 }
+"#,
+        )
+        .unwrap()
+    }
+
+    /// The edits a user makes, one per case; some make the design invalid or unprintable.
+    fn edit(d: &mut Design, which: u8, amount: f64) {
+        let a = amount; // in [0, 1)
+        match which % 22 {
+            0 => d.shape.lower = ContourSpec::Circle { radius: 20.0 + 10.0 * a },
+            1 => {
+                d.shape.upper = ContourSpec::Star {
+                    points: 5,
+                    outer_radius: 30.0,
+                    inner_radius: 20.0 + 5.0 * a,
+                }
+            }
+            2 => d.shape.samples = 24 + (a * 48.0) as usize,
+            3 => d.shape.height = 20.0 + 20.0 * a,
+            4 => {
+                if let Some(v) = d.control.vertical.last_mut() {
+                    let mid = v.points.len() / 2;
+                    v.points[mid][1] = 6.0 * a - 1.0;
+                }
+            }
+            5 => d.control.vertical.push(VerticalLine {
+                points: vec![[0.0, 0.0], [0.1 + 0.5 * a, 2.0], [0.9, 0.0], [1.0, 0.0]],
+                angle: Some(360.0 * a),
+                width: Some(40.0),
+            }),
+            6 => {
+                if !d.control.vertical.is_empty() {
+                    d.control.vertical.remove(0);
+                }
+            }
+            7 => {
+                if let Some(h) = d.control.horizontal.first_mut() {
+                    h.points[0][1] = 3.0 * a;
+                } else {
+                    d.control.horizontal = design().control.horizontal;
+                }
+            }
+            8 => {
+                if let Some(t) = &mut d.texture
+                    && let Some(x) = &mut t.x
+                {
+                    x.amplitude = 2.0 * a;
+                }
+            }
+            9 => d.texture = if a < 0.5 { None } else { design().texture },
+            10 => d.printer.print_speed = 10.0 + 20.0 * a,
+            11 => d.printer.max_overhang_deg = 30.0 + 20.0 * a,
+            12 => d.constraints.enforce = a < 0.5,
+            13 => d.shape.base_layers = (a * 4.0) as usize,
+            14 => d.printer.line_width = 2.0 + 3.0 * a,
+            15 => d.printer.layer_height = 0.8 + 0.8 * a,
+            16 => d.printer.min_layer_time = 20.0 * a,
+            // A bed too small for the vessel (an error from the surface stage), then back.
+            17 => d.printer.bed_x = if a < 0.5 { 40.0 } else { 180.0 },
+            // An invalid value (an error from validation).
+            18 => d.printer.line_width = if a < 0.5 { -1.0 } else { 3.5 },
+            19 => d.shape.center = Some([80.0 + 20.0 * a, 95.0]),
+            20 => d.printer.nozzle_length = 5.0 + 30.0 * a,
+            _ => d.printer.max_layer_height = 1.2 + a,
+        }
+    }
+
+    fn assert_same_as_batch(session: &Session, d: &Design, result: &Result<Update, FieldError>) {
+        let batch = {
+            let mut fresh = Session::new();
+            fresh.update(d).map(|_| fresh.job().unwrap())
+        };
+        match (result, batch) {
+            (Ok(_), Ok(b)) => {
+                let job = session.job().unwrap();
+                assert_eq!(*job.surface, *b.surface, "surface differs from a batch run");
+                assert_eq!(*job.toolpath, *b.toolpath, "toolpath differs from a batch run");
+                assert!(session.is_current());
+            }
+            (Err(e), Err(b)) => {
+                assert_eq!(e.to_string(), b.to_string());
+                assert!(!session.is_current());
+            }
+            (a, b) => panic!("incremental {a:?} but batch {:?}", b.map(|_| ())),
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+        /// Incremental equals batch: after every edit of a random sequence, the session's job is
+        /// exactly (bit for bit) the job a fresh run computes, and both fail alike.
+        #[test]
+        fn incremental_updates_equal_a_batch_run(
+            edits in proptest::collection::vec((0u8..22, 0.0f64..1.0), 1..12)
+        ) {
+            let mut d = design();
+            let mut session = Session::new();
+            let first = session.update(&d);
+            assert_same_as_batch(&session, &d, &first);
+            for (which, amount) in edits {
+                edit(&mut d, which, amount);
+                let r = session.update(&d);
+                assert_same_as_batch(&session, &d, &r);
+            }
+        }
+    }
+
+    #[test]
+    fn each_edit_recomputes_only_its_stages() {
+        let d = design();
+        let mut s = Session::new();
+        let first = s.update(&d).unwrap();
+        assert_eq!(first.contours, CONTOUR_FIELDS.to_vec());
+        assert!(first.plan && first.surface && first.toolpath);
+        let layers = s.model().unwrap().layers;
+        assert_eq!(first.sections, (0..=layers).collect::<Vec<_>>());
+        // No change: nothing.
+        assert!(s.update(&d).unwrap().is_nothing());
+        // A local line's point: only the sections in its span (0.3 … 0.7), then the rest.
+        let mut e = d.clone();
+        e.control.vertical[1].points[2][1] = 5.0;
+        let u = s.update(&e).unwrap();
+        assert!(u.contours.is_empty() && !u.plan && u.surface && u.toolpath);
+        let (lo, hi) = (u.sections[0], *u.sections.last().unwrap());
+        assert!(
+            lo as f64 >= 0.3 * layers as f64 - 1.0 && hi as f64 <= 0.7 * layers as f64 + 1.0,
+            "{:?} of {layers}",
+            u.sections
+        );
+        // The overhang limit: correction again, but no replanning and no section.
+        e.printer.max_overhang_deg = 40.0;
+        let u = s.update(&e).unwrap();
+        assert!(!u.plan && u.sections.is_empty() && u.surface && u.toolpath);
+        // The speed: only the toolpath.
+        e.printer.print_speed = 25.0;
+        let u = s.update(&e).unwrap();
+        assert_eq!(
+            u,
+            Update {
+                toolpath: true,
+                ..Update::default()
+            }
+        );
+        // The G-code-only settings: nothing at all.
+        e.printer.flow_multiplier = 1.1;
+        e.printer.thumbnail = false;
+        e.name = "renamed".into();
+        assert!(s.update(&e).unwrap().is_nothing());
+        // The upper contour: that contour, the plan and every section.
+        e.shape.upper = ContourSpec::Circle { radius: 28.0 };
+        let u = s.update(&e).unwrap();
+        assert_eq!(u.contours, vec!["shape.upper"]);
+        assert!(u.plan && u.sections.len() == s.model().unwrap().layers + 1);
+    }
+
+    #[test]
+    fn a_failed_update_keeps_the_last_job_and_recovers() {
+        let mut d = design();
+        d.shape.center = Some([90.0, 95.0]);
+        let mut s = Session::new();
+        s.update(&d).unwrap();
+        let good = s.job().unwrap();
+        // A bed too narrow: the fit on the machine (the surface stage) fails.
+        let mut e = d.clone();
+        e.printer.bed_x = 100.0;
+        let err = s.update(&e).unwrap_err();
+        assert!(err.to_string().contains("printer.bed_x"), "{err}");
+        assert!(!s.is_current());
+        assert_eq!(s.error().map(|e| e.to_string()), Some(err.to_string()));
+        assert_eq!(*s.job().unwrap().toolpath, *good.toolpath);
+        assert_eq!(s.design(), Some(&d));
+        // Back to the good design: the surface is recomputed (it failed), nothing before it.
+        let u = s.update(&d).unwrap();
+        assert!(u.contours.is_empty() && !u.plan && u.sections.is_empty() && u.surface);
+        assert!(s.is_current());
+    }
+}
