@@ -150,13 +150,17 @@ pub fn find_self_intersection(points: &[DVec2]) -> Option<(usize, usize)> {
 /// Outward unit normal in XY at each vertex of a counter-clockwise closed polyline, from the
 /// central difference `pᵢ₊₁ − pᵢ₋₁` rotated by −90°.
 pub fn outward_normals(points: &[DVec2]) -> Vec<DVec2> {
-    let n = points.len();
-    (0..n)
-        .map(|i| {
-            let d = points[(i + 1) % n] - points[(i + n - 1) % n];
-            DVec2::new(d.y, -d.x).normalize_or_zero()
-        })
+    (0..points.len())
+        .map(|i| outward_normal_at(points, i))
         .collect()
+}
+
+/// The outward unit normal of [`outward_normals`] at vertex i alone.
+#[inline]
+pub fn outward_normal_at(points: &[DVec2], i: usize) -> DVec2 {
+    let n = points.len();
+    let d = points[(i + 1) % n] - points[(i + n - 1) % n];
+    DVec2::new(d.y, -d.x).normalize_or_zero()
 }
 
 /// Distance from `p` to segment `a–b`, and the parameter `f ∈ [0, 1]` of the closest point.

@@ -10,7 +10,8 @@ use glam::{DVec2, DVec3};
 
 use crate::control::{HorizontalProfile, VerticalProfile};
 use crate::design::Design;
-use crate::geometry::outward_normals;
+use crate::control::angle_difference;
+use crate::geometry::{outward_normal_at, outward_normals};
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind};
 use crate::section::Section;
@@ -101,31 +102,126 @@ impl ShapeModel {
     /// control offsets. This is the per-section entry point the app calls for dirty sections.
     pub fn section(&self, k: usize) -> Section {
         let t = k as f64 / self.layers as f64;
+        let z0 = (k > 0).then_some(k as f64 * self.layer_pitch);
+        self.shaped_section(t, z0)
+    }
+
+    /// The shaped wall at any height fraction `t` (between sections too): the section the
+    /// printer would lay there. Control-line curves and handles are drawn on it.
+    pub fn section_at(&self, t: f64) -> Section {
+        let t = t.clamp(0.0, 1.0);
+        self.shaped_section(t, (t > 0.0).then_some(t * self.height))
+    }
+
+    /// The shaped points at height fraction t; `z0` is the nominal height (`None` on the bed,
+    /// where z = 0 whatever the horizontal lines do).
+    fn shaped_section(&self, t: f64, z0: Option<f64>) -> Section {
         let n = self.loft.samples();
         let xy: Vec<DVec2> = (0..n).map(|i| self.loft.point(i, t)).collect();
-        let active: Vec<(&VerticalProfile, f64)> = self
-            .vertical
-            .iter()
-            .map(|v| (v, v.offset_at(t)))
-            .filter(|(_, d)| *d != 0.0)
-            .collect();
+        let active = self.active_vertical(t, None);
         let normals = if active.is_empty() {
             Vec::new()
         } else {
             outward_normals(&xy)
         };
-        let z0 = k as f64 * self.layer_pitch;
         let points = (0..n)
             .map(|i| {
                 let mut p = xy[i];
                 for (v, d) in &active {
                     p += normals[i] * (d * v.weight_at(self.loft.angles[i]));
                 }
-                let z = if k == 0 { 0.0 } else { z0 + self.dz(i, t) };
+                let z = z0.map_or(0.0, |z0| z0 + self.dz(i, t));
                 DVec3::new(p.x, p.y, z)
             })
             .collect();
         Section { points }
+    }
+
+    /// The vertical lines with a non-zero offset at t and that offset, leaving out `skip`.
+    fn active_vertical(&self, t: f64, skip: Option<usize>) -> Vec<(&VerticalProfile, f64)> {
+        self.vertical
+            .iter()
+            .enumerate()
+            .filter(|(l, _)| Some(*l) != skip)
+            .map(|(_, v)| (v, v.offset_at(t)))
+            .filter(|(_, d)| *d != 0.0)
+            .collect()
+    }
+
+    /// The loft sample nearest to angle `phi` (radians, from the centre): the column a control
+    /// line at that angle runs on.
+    pub fn column_at_angle(&self, phi: f64) -> usize {
+        (0..self.loft.samples())
+            .min_by(|&a, &b| {
+                let da = angle_difference(self.loft.angles[a], phi).abs();
+                let db = angle_difference(self.loft.angles[b], phi).abs();
+                da.total_cmp(&db)
+            })
+            .unwrap_or(0)
+    }
+
+    /// Where on the wall column i at height fraction t a control line's offset is measured
+    /// from, and along which direction: the wall point is `base + dir · offset` with `base`
+    /// the wall without the vertical line `line` and `dir` the loft's outward normal scaled by
+    /// that line's angular weight (zero where the line does not reach). With `line = None`,
+    /// `base` is the wall point itself.
+    pub fn wall_frame(&self, i: usize, t: f64, line: Option<usize>) -> (DVec3, DVec2) {
+        let t = t.clamp(0.0, 1.0);
+        self.frame_at(i, t, (t > 0.0).then_some(t * self.height), line)
+    }
+
+    /// [`ShapeModel::wall_frame`] with the nominal height `z0` given (`None` on the bed).
+    fn frame_at(&self, i: usize, t: f64, z0: Option<f64>, line: Option<usize>) -> (DVec3, DVec2) {
+        let n = self.loft.samples();
+        if n == 0 {
+            return (DVec3::ZERO, DVec2::ZERO);
+        }
+        let i = i % n;
+        let xy: Vec<DVec2> = [(i + n - 1) % n, i, (i + 1) % n]
+            .iter()
+            .map(|&j| self.loft.point(j, t))
+            .collect();
+        let normal = outward_normal_at(&xy, 1);
+        let phi = self.loft.angles[i];
+        let mut base = xy[1];
+        for (v, d) in self.active_vertical(t, line) {
+            base += normal * (d * v.weight_at(phi));
+        }
+        let z = z0.map_or(0.0, |z0| z0 + self.dz(i, t));
+        let dir = line
+            .and_then(|l| self.vertical.get(l))
+            .map_or(DVec2::ZERO, |v| normal * v.weight_at(phi));
+        (base.extend(z), dir)
+    }
+
+    /// The shaped wall point of column i at height fraction t.
+    pub fn wall_point(&self, i: usize, t: f64) -> DVec3 {
+        self.wall_frame(i, t, None).0
+    }
+
+    /// Vertical control line l drawn on the wall: its column at every section height, so each
+    /// vertex is the point of the section the printer lays there.
+    pub fn vertical_line_curve(&self, l: usize, angle_deg: f64) -> Vec<DVec3> {
+        if l >= self.vertical.len() || self.loft.samples() == 0 {
+            return Vec::new();
+        }
+        let i = self.column_at_angle(angle_deg.to_radians());
+        (0..=self.layers)
+            .map(|k| {
+                let t = k as f64 / self.layers as f64;
+                self.frame_at(i, t, (k > 0).then_some(k as f64 * self.layer_pitch), None)
+                    .0
+            })
+            .collect()
+    }
+
+    /// A horizontal control line drawn on the wall at its height fraction `at`, closed.
+    pub fn horizontal_line_curve(&self, at: f64) -> Vec<DVec3> {
+        let mut points = self.section_at(at).points;
+        if let Some(first) = points.first().copied() {
+            points.push(first);
+        }
+        points
     }
 
     /// Sections whose shape a vertical control line's span `(t0, t1)` touches.
@@ -339,5 +435,66 @@ mod tests {
         assert!((r(30, 105) - 32.5).abs() < 1e-4, "{}", r(30, 105));
         assert!((r(30, 270) - 30.0).abs() < 1e-6);
         assert!((r(10, 90) - 30.0).abs() < 1e-6);
+    }
+}
+
+#[cfg(test)]
+mod wall_tests {
+    use super::*;
+    use crate::load::parse_design;
+
+    /// A non-circular loft (a star foot under an ellipse) with two overlapping vertical lines
+    /// and a horizontal line: where a radial push would leave the wall.
+    fn model() -> ShapeModel {
+        let d = parse_design(
+            "version = 1\n[shape]\nheight = 60.0\nsamples = 180\n\
+             [shape.lower]\ntype = \"star\"\npoints = 6\nouter_radius = 40.0\ninner_radius = 25.0\n\
+             [shape.upper]\ntype = \"ellipse\"\nrx = 35.0\nry = 20.0\n\
+             [[control.vertical]]\npoints = [[0.0, 0.0], [0.5, 6.0], [1.0, 0.0]]\n\
+             [[control.vertical]]\npoints = [[0.0, 0.0], [0.2, 0.0], [0.45, 4.0], [0.7, 0.0], [1.0, 0.0]]\nangle = 30.0\nwidth = 90.0\n\
+             [[control.horizontal]]\nat = 0.8\nreach = 0.2\npoints = [[0.0, 3.0], [180.0, -2.0]]\n",
+        )
+        .unwrap();
+        ShapeModel::new(&d, LoftInput::from_design(&d).unwrap())
+            .unwrap()
+            .0
+    }
+
+    #[test]
+    fn wall_points_are_the_printed_sections() {
+        let m = model();
+        for k in [0, 1, m.layers / 3, m.layers / 2, m.layers] {
+            let s = m.section(k);
+            let at = m.section_at(k as f64 / m.layers as f64);
+            for i in (0..m.loft.samples()).step_by(7) {
+                assert!(s.points[i].distance(at.points[i]) < 1e-9, "k {k} i {i}");
+                let w = m.wall_point(i, k as f64 / m.layers as f64);
+                assert!(s.points[i].distance(w) < 1e-9, "k {k} i {i}: {w} vs {}", s.points[i]);
+            }
+        }
+        // The vertical line's curve is its column of the sections, exactly.
+        let curve = m.vertical_line_curve(1, 30.0);
+        let i = m.column_at_angle(30f64.to_radians());
+        assert_eq!(curve.len(), m.layers + 1);
+        for (k, p) in curve.iter().enumerate() {
+            assert_eq!(*p, m.section(k).points[i]);
+        }
+    }
+
+    #[test]
+    fn a_frame_moves_the_wall_point_along_the_normal_by_the_weighted_offset() {
+        let m = model();
+        let t = 0.45;
+        let i = m.column_at_angle(30f64.to_radians());
+        let (base, dir) = m.wall_frame(i, t, Some(1));
+        let offset = m.vertical[1].offset_at(t);
+        assert!((offset - 4.0).abs() < 1e-12);
+        let on_wall = m.wall_point(i, t);
+        assert!((base.truncate() + dir * offset).distance(on_wall.truncate()) < 1e-9);
+        assert_eq!(base.z, on_wall.z);
+        // Near its own angle the weight is about 1: the direction is the normal, not the radius.
+        assert!((dir.length() - 1.0).abs() < 0.01, "{}", dir.length());
+        let radial = (on_wall.truncate() - m.loft.center).normalize();
+        assert!(dir.normalize().dot(radial) < 0.9999, "the star's normal is not radial here");
     }
 }

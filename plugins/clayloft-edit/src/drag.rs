@@ -48,15 +48,18 @@ struct HandleLook {
     selected: Handle<StandardMaterial>,
 }
 
+/// Mesh picking as the handles need it (only cameras and entities that opt in are picked); the
+/// app adds it once in its third-party set-up.
+pub fn picking_setup(app: &mut App) {
+    app.add_plugins(MeshPickingPlugin)
+        .insert_resource(MeshPickingSettings {
+            require_markers: true,
+            ..default()
+        });
+}
+
 pub(crate) fn plugin(app: &mut App) {
-    if !app.is_plugin_added::<MeshPickingPlugin>() {
-        app.add_plugins(MeshPickingPlugin);
-    }
-    app.insert_resource(MeshPickingSettings {
-        require_markers: true,
-        ..default()
-    })
-    .init_resource::<Selection>()
+    app.init_resource::<Selection>()
     .init_resource::<ActiveDrag>()
     .add_systems(Startup, make_handle_look)
     .add_systems(
@@ -223,7 +226,7 @@ fn start_drag(
     ev: On<Pointer<DragStart>>,
     handles: Query<(&EditHandle, &Transform)>,
     doc: Option<Res<DesignDoc>>,
-    cache: Res<ModelCache>,
+    engine: Res<Engine>,
     contours: Query<(&ContourRole, &ContourSamples)>,
     cams: Query<&GlobalTransform, With<Camera3d>>,
     mut drag: ResMut<ActiveDrag>,
@@ -233,7 +236,10 @@ fn start_drag(
     let (Ok((handle, t)), Some(doc)) = (handles.get(ev.entity), doc) else {
         return;
     };
-    let Some(frame) = handle_frame(handle.0, &doc.design, &cache, &contour_offsets(&contours))
+    let Some(model) = engine.0.model() else {
+        return;
+    };
+    let Some(frame) = handle_frame(handle.0, &doc.design, model, &contour_offsets(&contours))
     else {
         return;
     };

@@ -136,7 +136,7 @@ fn start_gizmo_drag(
     selection: Res<Selection>,
     handles: Query<(&EditHandle, &Transform)>,
     doc: Option<Res<DesignDoc>>,
-    cache: Res<ModelCache>,
+    engine: Res<Engine>,
     contours: Query<(&ContourRole, &ContourSamples)>,
     cams: Query<(&Camera, &GlobalTransform), With<Camera3d>>,
     mut drag: ResMut<GizmoDrag>,
@@ -148,7 +148,10 @@ fn start_gizmo_drag(
     let Some((_, t)) = handles.iter().find(|(h, _)| h.0 == role) else {
         return;
     };
-    let Some(frame) = handle_frame(role, &doc.design, &cache, &contour_offsets(&contours)) else {
+    let Some(model) = engine.0.model() else {
+        return;
+    };
+    let Some(frame) = handle_frame(role, &doc.design, model, &contour_offsets(&contours)) else {
         return;
     };
     let Some((o, d)) = pointer_ray(&cams, ev.pointer_location.position) else {

@@ -282,6 +282,10 @@ fn centre_line_plot(
 fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let view = &mut *view;
+    if view.run.is_some() {
+        // Snapshots arrive from the simulation thread: keep frames coming while it runs.
+        ctx.request_repaint();
+    }
     egui::Window::new("Extruder flow")
         .default_open(view.open)
         .pivot(egui::Align2::LEFT_BOTTOM)

@@ -19,6 +19,14 @@ pub enum ContourRole {
 
 impl ContourRole {
     pub const BOTH: [ContourRole; 2] = [ContourRole::Lower, ContourRole::Upper];
+    /// The contour's index in the core's session (`Session::contour`).
+    pub fn index(self) -> usize {
+        match self {
+            ContourRole::Lower => 0,
+            ContourRole::Upper => 1,
+        }
+    }
+
     /// Field path of the contour in the design file.
     pub fn field(self) -> &'static str {
         match self {

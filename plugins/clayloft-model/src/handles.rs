@@ -14,7 +14,8 @@ use std::collections::HashMap;
 
 use crate::components::{ContourRole, ContourSamples, EditHandle, HandlePosition, LineKind};
 use crate::document::DesignDoc;
-use crate::recompute::ModelCache;
+use crate::recompute::Engine;
+use clayloft_core::shape::ShapeModel;
 
 /// Which value of a contour a handle edits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -49,15 +50,19 @@ pub enum HandleRole {
     },
 }
 
-/// Where a handle's value is measured from: `origin` (design space) and the in-plane direction.
-/// For control lines, `lower`/`upper` are the loft column the handle rides on.
+/// Where a handle's value is measured from, in the current model (design space):
+/// - a contour value from `origin` (the contour's alignment offset) along `dir`;
+/// - a vertical line's offset from `origin` (the wall at the point's column and height without
+///   this line) along `dir` (the wall's outward normal times the line's angular weight), its
+///   height fraction from z / `height`;
+/// - a horizontal line's dz from `origin` (the wall there without this point's value) upward,
+///   `z_scale` mm per mm of dz (the horizontal-line scale the layer plan chose).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HandleFrame {
     pub origin: DVec3,
     pub dir: DVec2,
-    pub lower: DVec2,
-    pub upper: DVec2,
     pub height: f64,
+    pub z_scale: f64,
 }
 
 /// All handle roles a design has, in a stable order.
@@ -126,7 +131,7 @@ fn param_dir(spec: &ContourSpec, param: ContourParam) -> DVec2 {
 pub fn handle_frame(
     role: HandleRole,
     design: &Design,
-    cache: &ModelCache,
+    model: &ShapeModel,
     offsets: &HashMap<ContourRole, DVec2>,
 ) -> Option<HandleFrame> {
     let height = design.shape.height;
@@ -141,48 +146,44 @@ pub fn handle_frame(
             Some(HandleFrame {
                 origin: offset.extend(z),
                 dir: param_dir(contour_spec(design, contour), param),
-                lower: offset,
-                upper: offset,
                 height,
+                z_scale: 0.0,
             })
         }
-        HandleRole::Line { kind, line, .. } => {
-            let loft = &cache.model.as_ref()?.loft;
-            let angle = match kind {
-                LineKind::Vertical => design.control.vertical.get(line)?.angle.unwrap_or(0.0),
-                LineKind::Horizontal => {
-                    let h = design.control.horizontal.get(line)?;
-                    h.points.get(role_point(role))?[0]
-                }
-            };
-            let i = nearest_sample(&loft.angles, angle.to_radians())?;
-            let (lower, upper) = (loft.lower[i], loft.upper[i]);
-            let mid = (lower + upper) * 0.5;
+        HandleRole::Line {
+            kind: LineKind::Vertical,
+            line,
+            point,
+        } => {
+            let v = design.control.vertical.get(line)?;
+            let [t, _] = *v.points.get(point)?;
+            let column = model.column_at_angle(v.angle.unwrap_or(0.0).to_radians());
+            let (origin, dir) = model.wall_frame(column, t, Some(line));
             Some(HandleFrame {
-                origin: loft.center.extend(0.0),
-                dir: (mid - loft.center).normalize_or(DVec2::X),
-                lower,
-                upper,
+                origin,
+                dir,
                 height,
+                z_scale: 0.0,
+            })
+        }
+        HandleRole::Line {
+            kind: LineKind::Horizontal,
+            line,
+            point,
+        } => {
+            let h = design.control.horizontal.get(line)?;
+            let [angle, dz] = *h.points.get(point)?;
+            let column = model.column_at_angle(angle.to_radians());
+            let on_wall = model.wall_point(column, h.at);
+            let z_scale = model.hz_scale * model.horizontal.get(line)?.weight_at(h.at);
+            Some(HandleFrame {
+                origin: on_wall - DVec3::Z * (z_scale * dz),
+                dir: DVec2::ZERO,
+                height,
+                z_scale,
             })
         }
     }
-}
-
-fn role_point(role: HandleRole) -> usize {
-    match role {
-        HandleRole::Line { point, .. } => point,
-        HandleRole::Contour { .. } => 0,
-    }
-}
-
-/// Index of the sample whose angle is nearest `phi` (radians).
-pub fn nearest_sample(angles: &[f64], phi: f64) -> Option<usize> {
-    (0..angles.len()).min_by(|&a, &b| {
-        let da = clayloft_core::control::angle_difference(angles[a], phi).abs();
-        let db = clayloft_core::control::angle_difference(angles[b], phi).abs();
-        da.total_cmp(&db)
-    })
 }
 
 /// Where the handle of `role` sits (design space), given its frame.
@@ -201,15 +202,12 @@ pub fn handle_position(role: HandleRole, design: &Design, f: &HandleFrame) -> Op
         }
         HandleRole::Line { kind, line, point } => match kind {
             LineKind::Vertical => {
-                let [t, offset] = *design.control.vertical.get(line)?.points.get(point)?;
-                let base = f.lower.lerp(f.upper, t);
-                Some((base + f.dir * offset).extend(t * f.height))
+                let [_, offset] = *design.control.vertical.get(line)?.points.get(point)?;
+                Some(f.origin + (f.dir * offset).extend(0.0))
             }
             LineKind::Horizontal => {
-                let h = design.control.horizontal.get(line)?;
-                let [_, dz] = *h.points.get(point)?;
-                let base = f.lower.lerp(f.upper, h.at);
-                Some(base.extend(h.at * f.height + dz))
+                let [_, dz] = *design.control.horizontal.get(line)?.points.get(point)?;
+                Some(f.origin + DVec3::Z * (f.z_scale * dz))
             }
         },
     }
@@ -299,16 +297,24 @@ pub fn set_handle(role: HandleRole, design: &mut Design, f: &HandleFrame, target
                 } else {
                     (target.z / f.height).clamp(lo, hi.max(lo))
                 };
-                let base = f.lower.lerp(f.upper, t);
-                let offset = (target.truncate() - base).dot(f.dir);
+                // Along the wall's normal, per mm of offset as weighted at this column; where
+                // the line does not reach (zero weight) the offset cannot be dragged.
+                let along = f.dir.length_squared();
+                let offset = if along > 1e-12 {
+                    (target.truncate() - f.origin.truncate()).dot(f.dir) / along
+                } else {
+                    v.points[point][1]
+                };
                 v.points[point] = [round3(t), round3(offset)];
             }
             LineKind::Horizontal => {
                 let Some(h) = design.control.horizontal.get_mut(line) else {
                     return false;
                 };
-                if let Some(p) = h.points.get_mut(point) {
-                    p[1] = round3(target.z - h.at * f.height);
+                if let Some(p) = h.points.get_mut(point)
+                    && f.z_scale > 1e-12
+                {
+                    p[1] = round3((target.z - f.origin.z) / f.z_scale);
                 }
             }
         },
@@ -325,16 +331,22 @@ pub fn nudge_handle(world: &mut World, role: HandleRole, delta: DVec3) -> bool {
         .iter(world)
         .map(|(r, s)| (*r, s.offset))
         .collect();
-    let cache = world.resource::<ModelCache>().clone();
-    let Some(mut doc) = world.get_resource_mut::<DesignDoc>() else {
+    let (Some(engine), Some(doc)) = (
+        world.get_resource::<Engine>(),
+        world.get_resource::<DesignDoc>(),
+    ) else {
         return false;
     };
-    let Some(frame) = handle_frame(role, &doc.design, &cache, &offsets) else {
+    let Some(model) = engine.0.model() else {
+        return false;
+    };
+    let Some(frame) = handle_frame(role, &doc.design, model, &offsets) else {
         return false;
     };
     let Some(at) = handle_position(role, &doc.design, &frame) else {
         return false;
     };
+    let mut doc = world.resource_mut::<DesignDoc>();
     set_handle(role, &mut doc.design, &frame, at + delta)
 }
 
@@ -348,14 +360,17 @@ fn round3(v: f64) -> f64 {
 pub fn sync_handles(
     mut commands: Commands,
     doc: Option<Res<DesignDoc>>,
-    cache: Res<ModelCache>,
+    engine: Res<Engine>,
     contours: Query<(&ContourRole, &ContourSamples)>,
     mut handles: Query<(Entity, &EditHandle, &mut HandlePosition)>,
 ) {
     let Some(doc) = doc else { return };
-    if !doc.is_changed() && !cache.is_changed() {
+    if !doc.is_changed() && !engine.is_changed() {
         return;
     }
+    let Some(model) = engine.0.model() else {
+        return;
+    };
     let offsets: HashMap<ContourRole, DVec2> =
         contours.iter().map(|(r, s)| (*r, s.offset)).collect();
     let roles = handle_roles(&doc.design);
@@ -363,7 +378,7 @@ pub fn sync_handles(
     for (entity, handle, mut pos) in &mut handles {
         let placed = roles
             .contains(&handle.0)
-            .then(|| handle_frame(handle.0, &doc.design, &cache, &offsets))
+            .then(|| handle_frame(handle.0, &doc.design, model, &offsets))
             .flatten()
             .and_then(|f| handle_position(handle.0, &doc.design, &f));
         match placed {
@@ -375,7 +390,7 @@ pub fn sync_handles(
         }
     }
     for role in roles.into_iter().filter(|r| !seen.contains(r)) {
-        let placed = handle_frame(role, &doc.design, &cache, &offsets)
+        let placed = handle_frame(role, &doc.design, model, &offsets)
             .and_then(|f| handle_position(role, &doc.design, &f));
         if let Some(p) = placed {
             commands.spawn((
@@ -395,9 +410,8 @@ mod tests {
         HandleFrame {
             origin,
             dir,
-            lower: DVec2::new(100.0, 90.0),
-            upper: DVec2::new(120.0, 90.0),
             height: 100.0,
+            z_scale: 1.0,
         }
     }
 
@@ -472,19 +486,20 @@ points = [[0.0, 0.0], [0.5, 5.0], [1.0, 0.0]]
     #[test]
     fn vertical_line_point_drags_in_height_and_offset() {
         let mut d = design();
-        let f = frame(DVec3::ZERO, DVec2::X);
+        // The wall without this line at the point's column and height, and its normal there.
+        let f = frame(DVec3::new(110.0, 90.0, 50.0), DVec2::X);
         let mid = HandleRole::Line {
             kind: LineKind::Vertical,
             line: 0,
             point: 1,
         };
-        // t = 0.5 rides at x = 110 (lerp of 100 and 120); offset 5 mm along +x.
+        // Offset 5 mm along the normal.
         assert_eq!(
             handle_position(mid, &d, &f),
             Some(DVec3::new(115.0, 90.0, 50.0))
         );
         set_handle(mid, &mut d, &f, DVec3::new(122.0, 90.0, 60.0));
-        assert_eq!(d.control.vertical[0].points[1], [0.6, 10.0]);
+        assert_eq!(d.control.vertical[0].points[1], [0.6, 12.0]);
         // End points keep their height; only the offset changes.
         let end = HandleRole::Line {
             kind: LineKind::Vertical,
@@ -492,6 +507,10 @@ points = [[0.0, 0.0], [0.5, 5.0], [1.0, 0.0]]
             point: 2,
         };
         set_handle(end, &mut d, &f, DVec3::new(123.0, 90.0, 40.0));
-        assert_eq!(d.control.vertical[0].points[2], [1.0, 3.0]);
+        assert_eq!(d.control.vertical[0].points[2], [1.0, 13.0]);
+        // A half weight (the edge of a local line) doubles the offset a drag makes.
+        let half = frame(f.origin, DVec2::X * 0.5);
+        set_handle(mid, &mut d, &half, DVec3::new(112.0, 90.0, 60.0));
+        assert_eq!(d.control.vertical[0].points[1], [0.6, 4.0]);
     }
 }

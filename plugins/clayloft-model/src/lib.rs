@@ -10,16 +10,16 @@
 //! - the vessel ([`Vessel`]) holding the corrected, textured [`VesselSurface`];
 //! - the toolpath ([`ToolpathPath`]).
 //!
-//! [`plan::plan_recompute`] compares the last computed design with the edited one and says what
-//! must be redone: a local vertical control line recomputes only the sections in its span, a
-//! contour recomputes that contour's samples and then the sections, other settings only the
-//! finishing stages. The math is the core library's ([`clayloft_core`]); nothing here repeats it.
+//! The core's incremental engine ([`clayloft_core::Session`], held in [`Engine`]) decides what an
+//! edit must redo: a local vertical control line recomputes only the sections in its span, a
+//! contour that contour's samples and then the sections, a speed only the toolpath. The systems
+//! here copy its outputs into components; the math, the control-line curves and the handle
+//! positions are the core library's ([`clayloft_core`]); nothing here repeats it.
 
 pub mod components;
 pub mod coords;
 pub mod document;
 pub mod handles;
-pub mod plan;
 pub mod preview;
 pub mod recompute;
 
@@ -27,7 +27,7 @@ use bevy::prelude::*;
 
 pub use components::*;
 pub use document::{DesignDoc, ModelStatus};
-pub use recompute::{ModelCache, RecomputeLog};
+pub use recompute::{Engine, RecomputeLog};
 
 /// Order of the model's systems within `Update`.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -46,7 +46,7 @@ pub struct ModelPlugin;
 impl Plugin for ModelPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<ModelStatus>()
-            .init_resource::<ModelCache>()
+            .init_resource::<Engine>()
             .init_resource::<RecomputeLog>()
             .configure_sets(
                 Update,

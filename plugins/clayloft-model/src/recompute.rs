@@ -1,44 +1,32 @@
-//! The recompute systems: from the edited design to the derived entities, doing only the work
-//! [`plan_recompute`] says an edit needs.
+//! The recompute systems: the core's incremental engine ([`Session`]) brought up to date with
+//! the edited design, and its outputs copied into the derived entities. What an edit
+//! invalidates is the session's business; nothing here decides it.
 
-use std::collections::BTreeSet;
 use std::sync::Arc;
 
-use bevy::math::{DVec2, DVec3};
+use bevy::math::DVec3;
 use bevy::prelude::*;
-use clayloft_core::Design;
-use clayloft_core::loft::{LoftInput, sample_contour};
-use clayloft_core::pipeline::finish_surface;
-use clayloft_core::report::Finding;
-use clayloft_core::section::Section;
-use clayloft_core::shape::ShapeModel;
-use clayloft_core::toolpath::build_toolpath;
-use clayloft_core::validate::validate;
+use clayloft_core::Session;
+use clayloft_core::session::Update;
 
 use crate::components::*;
 use crate::document::{DesignDoc, ModelStatus};
-use crate::plan::{Recompute, plan_recompute};
 
-/// What the last successful recompute was computed from.
-#[derive(Resource, Debug, Clone, Default)]
-pub struct ModelCache {
-    /// The design the derived entities show.
-    pub design: Option<Design>,
-    /// Its shape model (loft, control profiles, layer plan).
-    pub model: Option<ShapeModel>,
-    /// The layer plan's findings.
-    pub plan_findings: Vec<Finding>,
-}
+/// The core's incremental engine for the design being edited.
+#[derive(Resource, Debug, Default)]
+pub struct Engine(pub Session);
 
 /// What the last recompute did, for tests, benchmarks and the status line.
 #[derive(Resource, Debug, Clone, Default, PartialEq)]
 pub struct RecomputeLog {
-    /// Recompute passes so far.
+    /// Successful recompute passes so far (a pass that recomputed something).
     pub passes: u64,
     /// Contours resampled in the last pass.
     pub resampled: Vec<ContourRole>,
     /// Sections reshaped in the last pass, ascending.
     pub sections: Vec<usize>,
+    /// The session's account of the last pass.
+    pub update: Update,
 }
 
 /// Spawns the two contour entities, the vessel and the toolpath entity.
@@ -54,12 +42,13 @@ pub fn spawn_model_entities(mut commands: Commands) {
 #[derive(Component, Debug, Clone, Copy, Default)]
 pub struct ToolpathMarker;
 
-/// Recomputes the derived entities when the design changed (change detection on
-/// [`DesignDoc`]); never runs otherwise.
+/// Updates the session when the design changed (change detection on [`DesignDoc`]; never runs
+/// otherwise) and copies what it recomputed into the entities.
+#[allow(clippy::too_many_arguments)]
 pub fn recompute_model(
     mut commands: Commands,
     doc: Option<Res<DesignDoc>>,
-    mut cache: ResMut<ModelCache>,
+    mut engine: ResMut<Engine>,
     mut status: ResMut<ModelStatus>,
     mut log: ResMut<RecomputeLog>,
     mut contours: Query<(&ContourRole, &mut ContourSamples)>,
@@ -71,158 +60,98 @@ pub fn recompute_model(
     if !doc.is_changed() {
         return;
     }
-    let design = &doc.design;
-    if let Err(e) = validate(design) {
-        status.error = Some(e.to_string());
-        return;
-    }
-    let plan = plan_recompute(cache.design.as_ref(), design, cache.model.as_ref());
-    if plan == Recompute::Nothing {
-        status.error = None;
-        return;
-    }
-    // Stage 1: contours.
-    let resample: Vec<ContourRole> = match &plan {
-        Recompute::Everything => ContourRole::BOTH.to_vec(),
-        Recompute::Contours(roles) => roles.clone(),
-        _ => Vec::new(),
+    let update = match engine.0.update(&doc.design) {
+        Ok(u) => u,
+        Err(e) => {
+            status.error = Some(e.to_string());
+            return;
+        }
     };
-    let [cx, cy] = design.center();
-    let center = DVec2::new(cx, cy);
-    let mut new_samples = Vec::new();
-    for role in &resample {
-        let spec = crate::handles::contour_spec(design, *role);
-        match sample_contour(
-            spec,
-            role.field(),
-            center,
-            design.shape.samples,
-            design.base_dir.as_deref(),
-        ) {
-            Ok(c) => new_samples.push((*role, c)),
-            Err(e) => {
-                status.error = Some(e.to_string());
-                return;
-            }
+    status.error = None;
+    if update.is_nothing() {
+        return;
+    }
+    let session = &engine.0;
+    // Contours.
+    let resampled: Vec<ContourRole> = ContourRole::BOTH
+        .into_iter()
+        .filter(|r| update.contours.contains(&r.field()))
+        .collect();
+    for (role, mut samples) in &mut contours {
+        if resampled.contains(role)
+            && let Some(c) = session.contour(role.index())
+        {
+            *samples = ContourSamples {
+                samples: c.samples.clone(),
+                offset: c.offset,
+            };
         }
     }
-    // Stage 2: the shape model (loft + control lines + layer plan).
-    let (model, plan_findings, dirty): (ShapeModel, Vec<Finding>, Option<BTreeSet<usize>>) =
-        match (&plan, cache.model.as_ref()) {
-            (Recompute::Sections(dirty), Some(old)) => {
-                let mut m = old.clone();
-                m.vertical = design
-                    .control
-                    .vertical
-                    .iter()
-                    .map(clayloft_core::control::VerticalProfile::new)
-                    .collect();
-                (m, cache.plan_findings.clone(), Some(dirty.clone()))
-            }
-            (Recompute::Finish, Some(old)) => (
-                old.clone(),
-                cache.plan_findings.clone(),
-                Some(BTreeSet::new()),
-            ),
-            _ => {
-                let sample_of = |role: ContourRole| -> Vec<DVec2> {
-                    if let Some((_, c)) = new_samples.iter().find(|(r, _)| *r == role) {
-                        return c.samples.clone();
-                    }
-                    contours
-                        .iter()
-                        .find(|(r, _)| **r == role)
-                        .map(|(_, s)| s.samples.clone())
-                        .unwrap_or_default()
-                };
-                let loft = LoftInput::from_samples(
-                    sample_of(ContourRole::Lower),
-                    sample_of(ContourRole::Upper),
-                    center,
-                );
-                match ShapeModel::new(design, loft) {
-                    Ok((m, f)) => (m, f, None),
-                    Err(e) => {
-                        status.error = Some(e.to_string());
-                        return;
-                    }
-                }
-            }
-        };
-    // Stage 3: sections, one entity per section; only the dirty ones are reshaped.
-    let count = model.layers + 1;
-    let mut shaped: Vec<Option<Section>> = vec![None; count];
-    let mut reshaped = Vec::new();
+    // Sections: one entity per section, the reshaped ones copied.
+    let count = session.model().map_or(0, |m| m.layers + 1);
+    let mut present = vec![false; count];
     for (entity, index, mut section) in &mut sections {
         let k = index.0;
         if k >= count {
             commands.entity(entity).despawn();
             continue;
         }
-        let needed = dirty.as_ref().is_none_or(|d| d.contains(&k));
-        if needed {
-            section.0 = model.section(k);
-            reshaped.push(k);
+        present[k] = true;
+        if update.sections.binary_search(&k).is_ok()
+            && let Some(s) = session.shaped_section(k)
+        {
+            section.0 = s.clone();
         }
-        shaped[k] = Some(section.0.clone());
     }
-    for (k, slot) in shaped.iter_mut().enumerate() {
-        if slot.is_none() {
-            let s = model.section(k);
+    for (k, _) in present.iter().enumerate().filter(|(_, p)| !**p) {
+        if let Some(s) = session.shaped_section(k) {
             commands.spawn((SectionIndex(k), ShapedSection(s.clone())));
-            reshaped.push(k);
-            *slot = Some(s);
         }
     }
-    reshaped.sort_unstable();
-    let shaped: Vec<Section> = shaped.into_iter().map(Option::unwrap_or_default).collect();
-    // Stages 4–6: constraints, texture, toolpath (whole surface).
-    let built = finish_surface(design, &model, shaped, plan_findings.clone())
-        .and_then(|surface| build_toolpath(design, &surface).map(|path| (surface, path)));
-    let (surface, path) = match built {
-        Ok(b) => b,
-        Err(e) => {
-            status.error = Some(e.to_string());
-            // Section entities now hold this design's shapes: the next pass starts afresh.
-            cache.design = None;
-            cache.model = None;
-            return;
-        }
-    };
-    for (role, c) in new_samples {
-        if let Some((_, mut s)) = contours.iter_mut().find(|(r, _)| **r == role) {
-            *s = ContourSamples {
-                samples: c.samples,
-                offset: c.offset,
-            };
-        }
+    // The corrected surface and the toolpath, shared with the session.
+    if update.surface
+        && let Some(surface) = session.surface()
+    {
+        commands
+            .entity(*vessel)
+            .insert(VesselSurface(Arc::clone(surface)));
     }
-    commands
-        .entity(*vessel)
-        .insert(VesselSurface(Arc::new(surface)));
-    commands
-        .entity(*toolpath)
-        .insert(ToolpathPath(Arc::new(path)));
-    status.error = None;
+    if update.toolpath
+        && let Some(path) = session.toolpath()
+    {
+        commands
+            .entity(*toolpath)
+            .insert(ToolpathPath(Arc::clone(path)));
+    }
     log.passes += 1;
-    log.resampled = resample;
-    log.sections = reshaped;
-    cache.design = Some(design.clone());
-    cache.model = Some(model);
-    cache.plan_findings = plan_findings;
+    log.resampled = resampled;
+    log.sections = update.sections.clone();
+    log.update = update;
 }
 
-/// Keeps one entity per control line with its curve drawn on the loft (design space).
+/// Keeps one entity per control line with its curve on the wall, from the core's shape model.
 pub fn derive_control_lines(
     mut commands: Commands,
-    cache: Res<ModelCache>,
+    engine: Res<Engine>,
     mut lines: Query<(Entity, &ControlLine, &mut ControlLineCurve)>,
 ) {
-    if !cache.is_changed() {
+    if !engine.is_changed() {
         return;
     }
-    let (Some(design), Some(model)) = (&cache.design, &cache.model) else {
+    let (Some(design), Some(model)) = (engine.0.design(), engine.0.model()) else {
         return;
+    };
+    let curve = |line: ControlLine| -> Vec<DVec3> {
+        match line.kind {
+            LineKind::Vertical => design.control.vertical.get(line.index).map_or_else(Vec::new, |v| {
+                model.vertical_line_curve(line.index, v.angle.unwrap_or(0.0))
+            }),
+            LineKind::Horizontal => design
+                .control
+                .horizontal
+                .get(line.index)
+                .map_or_else(Vec::new, |h| model.horizontal_line_curve(h.at)),
+        }
     };
     let wanted: Vec<ControlLine> = (0..design.control.vertical.len())
         .map(|index| ControlLine {
@@ -237,57 +166,15 @@ pub fn derive_control_lines(
         )
         .collect();
     let mut seen = Vec::new();
-    for (entity, line, mut curve) in &mut lines {
+    for (entity, line, mut drawn) in &mut lines {
         if wanted.contains(line) {
-            curve.0 = line_curve(*line, design, model);
+            drawn.0 = curve(*line);
             seen.push(*line);
         } else {
             commands.entity(entity).despawn();
         }
     }
     for line in wanted.into_iter().filter(|l| !seen.contains(l)) {
-        commands.spawn((line, ControlLineCurve(line_curve(line, design, model))));
-    }
-}
-
-/// A vertical line runs up the loft at its angle, offset by its profile; a horizontal line runs
-/// around the loft at its height, raised by its profile.
-fn line_curve(line: ControlLine, design: &Design, model: &ShapeModel) -> Vec<DVec3> {
-    let loft = &model.loft;
-    let n = loft.samples();
-    if n == 0 {
-        return Vec::new();
-    }
-    let h = design.shape.height;
-    match line.kind {
-        LineKind::Vertical => {
-            let Some(v) = design.control.vertical.get(line.index) else {
-                return Vec::new();
-            };
-            let profile = &model.vertical[line.index];
-            let phi = v.angle.unwrap_or(0.0).to_radians();
-            let i = crate::handles::nearest_sample(&loft.angles, phi).unwrap_or(0);
-            (0..=64)
-                .map(|j| {
-                    let t = j as f64 / 64.0;
-                    let p = loft.point(i, t);
-                    let dir = (p - loft.center).normalize_or(DVec2::X);
-                    (p + dir * profile.offset_at(t)).extend(t * h)
-                })
-                .collect()
-        }
-        LineKind::Horizontal => {
-            let Some(hl) = design.control.horizontal.get(line.index) else {
-                return Vec::new();
-            };
-            let profile = &model.horizontal[line.index];
-            (0..=n)
-                .map(|j| {
-                    let i = j % n;
-                    let p = loft.point(i, hl.at);
-                    p.extend(hl.at * h + profile.dz_at(loft.angles[i]) * model.hz_scale)
-                })
-                .collect()
-        }
+        commands.spawn((line, ControlLineCurve(curve(line))));
     }
 }

@@ -96,7 +96,8 @@ fn local_line_handle_recomputes_only_its_span() {
     let log = app.world().resource::<RecomputeLog>().clone();
     assert_eq!(log.passes, 2);
     assert!(log.resampled.is_empty());
-    let first = (0.7 * layers as f64).floor() as usize;
+    // Exactly the sections above t = 0.7, where the line's offset is not zero.
+    let first = (0.7 * layers as f64).floor() as usize + 1;
     assert_eq!(log.sections, (first..=layers).collect::<Vec<_>>());
     assert!(log.sections.len() < layers / 2);
     assert_matches_pipeline(&mut app);
@@ -206,4 +207,120 @@ fn removing_a_control_line_removes_its_entities() {
     let handles = count::<EditHandle>(&mut app);
     assert_eq!(handles, 15);
     assert_matches_pipeline(&mut app);
+}
+
+/// Distance from `p` to the closed polyline `ring` (3D).
+fn distance_to_ring(p: bevy::math::DVec3, ring: &[bevy::math::DVec3]) -> f64 {
+    (0..ring.len())
+        .map(|j| {
+            let (a, b) = (ring[j], ring[(j + 1) % ring.len()]);
+            let ab = b - a;
+            let f = if ab.length_squared() > 0.0 {
+                ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            p.distance(a + ab * f)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// On every shipped design, the control-line curves the view draws and the control-line
+/// handles the user drags lie on the shaped wall (the section the printer lays at that height)
+/// within 0.01 mm — on stars, splines and traced pictures, where a radial push leaves the wall.
+#[test]
+fn control_lines_and_their_handles_lie_on_the_wall_of_every_shipped_design() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/designs");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    let mut checked = 0;
+    for name in &names {
+        let mut app = app_with(load(name));
+        let design = app.world().resource::<DesignDoc>().design.clone();
+        let engine = app.world().resource::<Engine>();
+        let model = engine.0.model().unwrap().clone();
+        // Handles of control-line points.
+        let mut q = app.world_mut().query::<(&EditHandle, &HandlePosition)>();
+        for (handle, pos) in q.iter(app.world()) {
+            let HandleRole::Line { kind, line, point } = handle.0 else {
+                continue;
+            };
+            let t = match kind {
+                LineKind::Vertical => design.control.vertical[line].points[point][0],
+                LineKind::Horizontal => design.control.horizontal[line].at,
+            };
+            let wall = model.section_at(t).points;
+            let d = distance_to_ring(pos.0, &wall);
+            assert!(d < 0.01, "{name}: {:?} is {d:.4} mm off the wall", handle.0);
+            checked += 1;
+        }
+        // The drawn curves: vertical ones vertex by vertex on the section entities, horizontal
+        // ones on the wall at their height.
+        let mut sections: Vec<(usize, Vec<bevy::math::DVec3>)> = app
+            .world_mut()
+            .query::<(&SectionIndex, &ShapedSection)>()
+            .iter(app.world())
+            .map(|(k, s)| (k.0, s.0.points.clone()))
+            .collect();
+        sections.sort_by_key(|(k, _)| *k);
+        let mut q = app.world_mut().query::<(&ControlLine, &ControlLineCurve)>();
+        for (line, curve) in q.iter(app.world()) {
+            assert!(!curve.0.is_empty(), "{name}: {line:?} drawn empty");
+            for (k, p) in curve.0.iter().enumerate() {
+                let d = match line.kind {
+                    LineKind::Vertical => distance_to_ring(*p, &sections[k].1),
+                    LineKind::Horizontal => distance_to_ring(
+                        *p,
+                        &model
+                            .section_at(design.control.horizontal[line.index].at)
+                            .points,
+                    ),
+                };
+                assert!(d < 0.01, "{name}: {line:?} vertex {k} is {d:.4} mm off the wall");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 100, "only {checked} points checked");
+}
+
+/// Dragging a control-line handle moves it under the pointer: along the wall's normal, the
+/// handle lands where it was dragged to (within rounding to 0.001 mm).
+#[test]
+fn a_dragged_line_handle_lands_where_it_was_dragged() {
+    let mut app = app_with(load("pebble-spout.toml"));
+    let tip = HandleRole::Line {
+        kind: LineKind::Vertical,
+        line: 0,
+        point: 2,
+    };
+    let before = handle_at(&mut app, tip);
+    let normal = {
+        let engine = app.world().resource::<Engine>();
+        let model = engine.0.model().unwrap();
+        let design = &app.world().resource::<DesignDoc>().design;
+        let v = &design.control.vertical[0];
+        let i = model.column_at_angle(v.angle.unwrap_or(0.0).to_radians());
+        model.wall_frame(i, v.points[2][0], Some(0)).1
+    };
+    drag(&mut app, tip, (normal * 3.0).extend(0.0));
+    app.update();
+    let after = handle_at(&mut app, tip);
+    let moved = after - before;
+    assert!(
+        (moved.truncate().dot(normal.normalize()) - 3.0 * normal.length()).abs() < 0.01,
+        "moved {moved}"
+    );
+}
+
+fn handle_at(app: &mut App, role: HandleRole) -> bevy::math::DVec3 {
+    let mut q = app.world_mut().query::<(&EditHandle, &HandlePosition)>();
+    q.iter(app.world())
+        .find(|(h, _)| h.0 == role)
+        .map(|(_, p)| p.0)
+        .unwrap()
 }

@@ -9,7 +9,7 @@ mod widgets;
 use std::path::PathBuf;
 
 use bevy::prelude::*;
-use bevy_egui::{EguiContexts, EguiPlugin, EguiPrimaryContextPass, egui};
+use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use clayloft_core::gcode::format_duration;
 use clayloft_edit::{HistoryCommand, PanelInUse, Selection};
 use clayloft_files::{FileCommand, FileStatus};
@@ -31,9 +31,6 @@ pub struct PanelsPlugin;
 
 impl Plugin for PanelsPlugin {
     fn build(&self, app: &mut App) {
-        if !app.is_plugin_added::<EguiPlugin>() {
-            app.add_plugins(EguiPlugin::default());
-        }
         app.init_resource::<FileFields>().add_systems(
             EguiPrimaryContextPass,
             (draw_panels, draw_source_previews).chain(),
@@ -51,13 +48,13 @@ fn draw_panels(
     mut history_cmd: MessageWriter<HistoryCommand>,
     history: Res<clayloft_edit::History>,
     mut settings: ResMut<ViewSettings>,
-    mut replay: ResMut<Replay>,
-    replay_path: Res<ReplayPath>,
+    (mut replay, replay_path): (ResMut<Replay>, Res<ReplayPath>),
     wall: Res<WallStats>,
     vessel: Query<&VesselSurface>,
     toolpath: Query<&ToolpathPath>,
     selection: Res<Selection>,
     mut panel: ResMut<PanelInUse>,
+    mut path_figures: Local<(usize, f64, f64)>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let Some(mut doc) = doc else { return Ok(()) };
@@ -131,23 +128,31 @@ fn draw_panels(
                 history_cmd.write(HistoryCommand::Redo);
             }
             ui.separator();
-            ui.checkbox(&mut settings.show_wall, "wall");
-            ui.checkbox(&mut settings.show_toolpath, "toolpath");
-            ui.checkbox(&mut settings.show_control_lines, "control lines");
-            ui.checkbox(&mut settings.show_build_volume, "build volume");
+            // Edited on a copy and written back only when a box changed: a `ResMut` touched
+            // every frame would tell the view to rebuild every frame.
+            let mut shown = *settings;
+            ui.checkbox(&mut shown.show_wall, "wall");
+            ui.checkbox(&mut shown.show_toolpath, "toolpath");
+            ui.checkbox(&mut shown.show_control_lines, "control lines");
+            ui.checkbox(&mut shown.show_build_volume, "build volume");
+            settings.set_if_neq(shown);
         });
     });
 
     egui::Panel::bottom("status line").show(&mut root, |ui| {
         ui.horizontal_wrapped(|ui| {
             if let (Some(s), Some(tp)) = (vessel.iter().next(), toolpath.iter().next()) {
-                let job_time = tp.0.print_time();
+                // Length and time walk the whole path: once per toolpath, not once per frame.
+                let key = std::sync::Arc::as_ptr(&tp.0) as usize;
+                if path_figures.0 != key {
+                    *path_figures = (key, tp.0.length(), tp.0.print_time());
+                }
                 ui.label(format!(
                     "{} layers · {} points · path {:.1} m · print ≈ {} · max overhang {:.1}°",
                     s.0.layers,
                     tp.0.points.len(),
-                    tp.0.length() / 1000.0,
-                    format_duration(job_time),
+                    path_figures.1 / 1000.0,
+                    format_duration(path_figures.2),
                     s.0.metrics.max_overhang_deg,
                 ));
                 if wall.violating_points > 0 {
@@ -188,7 +193,9 @@ fn draw_panels(
         .default_size(300.0)
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                replay_panel(ui, &mut replay, &replay_path);
+                let mut edited = replay.clone();
+                replay_panel(ui, &mut edited, &replay_path);
+                replay.set_if_neq(edited);
                 ui.separator();
                 findings_panel(ui, vessel.iter().next(), &design);
             });
@@ -197,9 +204,11 @@ fn draw_panels(
     if design != doc.design {
         doc.design = design;
     }
-    panel.hovered = ctx.egui_wants_pointer_input() || ctx.is_pointer_over_egui();
-    panel.editing = ctx.egui_is_using_pointer();
-    panel.typing = ctx.egui_wants_keyboard_input();
+    panel.set_if_neq(PanelInUse {
+        hovered: ctx.egui_wants_pointer_input() || ctx.is_pointer_over_egui(),
+        editing: ctx.egui_is_using_pointer(),
+        typing: ctx.egui_wants_keyboard_input(),
+    });
     Ok(())
 }
 

@@ -193,6 +193,11 @@ fn draw_printer_window(
     doc: Option<Res<DesignDoc>>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
+    if panel.job.is_some() {
+        // The link thread's news arrives on a channel: keep frames coming while a job streams
+        // (the app otherwise sleeps until the next input).
+        ctx.request_repaint();
+    }
     egui::Window::new("Printer")
         .default_open(false)
         .pivot(egui::Align2::LEFT_BOTTOM)

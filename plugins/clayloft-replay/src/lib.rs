@@ -18,7 +18,7 @@ use clayloft_view::ViewSettings;
 pub use timeline::Timeline;
 
 /// Replay state: the panels drive it, the systems follow it.
-#[derive(Resource, Debug, Clone)]
+#[derive(Resource, Debug, Clone, PartialEq)]
 pub struct Replay {
     /// The replay is shown (nozzle, growing part) instead of the finished wall.
     pub active: bool,
@@ -130,10 +130,23 @@ impl Plugin for ReplayPlugin {
                     grow_printed_part,
                     swap_wall_for_printed_part,
                     draw_flags,
+                    keep_drawing_while_playing,
                 )
                     .chain()
                     .in_set(ModelSystems::View),
             );
+    }
+}
+
+/// The app draws only on input (reactive rendering): a playing replay asks for the next frame.
+fn keep_drawing_while_playing(
+    replay: Res<Replay>,
+    redraw: Option<ResMut<Messages<bevy::window::RequestRedraw>>>,
+) {
+    if replay.playing
+        && let Some(mut redraw) = redraw
+    {
+        redraw.write(bevy::window::RequestRedraw);
     }
 }
 

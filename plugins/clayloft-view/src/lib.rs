@@ -5,7 +5,7 @@
 use bevy::camera::visibility::Visibility;
 use bevy::picking::Pickable;
 use bevy::prelude::*;
-use bevy_panorbit_camera::{PanOrbitCamera, PanOrbitCameraPlugin};
+use bevy_panorbit_camera::PanOrbitCamera;
 use clayloft_model::coords::to_world;
 use clayloft_model::preview::wall_buffers;
 use clayloft_model::*;
@@ -42,6 +42,13 @@ pub struct ToolpathView;
 #[derive(Component, Debug, Clone, Copy)]
 pub struct BedView;
 
+/// How often the view rebuilt its meshes and lines (tests count them over idle frames: zero).
+#[derive(Resource, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ViewRebuilds {
+    pub wall_mesh: u64,
+    pub toolpath_lines: u64,
+}
+
 /// Number of wall points past the overhang limit (for the status line).
 #[derive(Resource, Debug, Clone, Copy, Default)]
 pub struct WallStats {
@@ -53,11 +60,9 @@ pub struct ViewPlugin;
 
 impl Plugin for ViewPlugin {
     fn build(&self, app: &mut App) {
-        if !app.is_plugin_added::<PanOrbitCameraPlugin>() {
-            app.add_plugins(PanOrbitCameraPlugin);
-        }
         app.init_resource::<ViewSettings>()
             .init_resource::<WallStats>()
+            .init_resource::<ViewRebuilds>()
             .insert_resource(ClearColor(Color::srgb(0.13, 0.14, 0.16)))
             .add_systems(Startup, spawn_scene)
             .add_systems(
@@ -70,9 +75,28 @@ impl Plugin for ViewPlugin {
                     apply_view_settings,
                     draw_build_volume,
                     draw_control_lines,
+                    keep_drawing_while_the_camera_moves,
                 )
                     .in_set(ModelSystems::View),
             );
+    }
+}
+
+/// The app draws only on input (reactive rendering); the orbit camera eases towards its target
+/// after the input stopped, so it asks for frames until it arrives.
+fn keep_drawing_while_the_camera_moves(
+    cams: Query<&PanOrbitCamera>,
+    redraw: Option<ResMut<Messages<bevy::window::RequestRedraw>>>,
+) {
+    let moving = cams.iter().any(|c| {
+        let off = |a: Option<f32>, b: f32| a.is_none_or(|a| (a - b).abs() > 1e-4);
+        off(c.yaw, c.target_yaw)
+            || off(c.pitch, c.target_pitch)
+            || off(c.radius, c.target_radius)
+            || c.focus.distance(c.target_focus) > 1e-3
+    });
+    if moving && let Some(mut redraw) = redraw {
+        redraw.write(bevy::window::RequestRedraw);
     }
 }
 
@@ -210,10 +234,12 @@ fn rebuild_wall_mesh(
     wall: Single<&Mesh3d, With<WallView>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut stats: ResMut<WallStats>,
+    mut rebuilds: ResMut<ViewRebuilds>,
 ) {
     let (Some(surface), Some(doc)) = (vessel.iter().next(), doc) else {
         return;
     };
+    rebuilds.wall_mesh += 1;
     let buffers = wall_buffers(&surface.0, doc.design.printer.max_overhang_deg);
     stats.violating_points = buffers.violating;
     let _ = meshes.insert(wall.0.id(), buffers.into_mesh());
@@ -225,6 +251,7 @@ fn rebuild_toolpath_lines(
     settings: Res<ViewSettings>,
     view: Single<&Gizmo, With<ToolpathView>>,
     mut assets: ResMut<Assets<GizmoAsset>>,
+    mut rebuilds: ResMut<ViewRebuilds>,
 ) {
     let Some(path) = path.iter().next() else {
         return;
@@ -232,6 +259,7 @@ fn rebuild_toolpath_lines(
     if !path.is_changed() && !settings.is_changed() {
         return;
     }
+    rebuilds.toolpath_lines += 1;
     let mut asset = GizmoAsset::new();
     if !settings.show_toolpath {
         let _ = assets.insert(view.handle.id(), asset);
