@@ -11,31 +11,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, DVec3};
 
 /// 720 samples per section, 150 mm at 0.5 mm layers = 300 layers, with a belly and a texture.
-const BIG_DESIGN: &str = r#"
-version = 1
-name = "benchmark vase"
-[printer]
-layer_height = 0.5
-[shape]
-height = 150.0
-samples = 720
-base_layers = 2
-[shape.lower]
-type = "circle"
-radius = 40.0
-[shape.upper]
-type = "rose"
-radius = 45.0
-amplitude = 8.0
-petals = 6
-[[control.vertical]]
-points = [[0.0, 0.0], [0.5, 12.0], [1.0, 0.0]]
-[texture]
-[texture.x]
-wave = "sine"
-period = 12
-amplitude = 0.8
-"#;
+const BIG_DESIGN: &str = include_str!("../../../assets/benchmarks/vase-720x300.toml");
 
 fn pipeline(c: &mut Criterion) {
     let dir = tempfile::tempdir().unwrap();

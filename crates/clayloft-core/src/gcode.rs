@@ -233,9 +233,69 @@ pub fn write_program(
     job: &PrintJob,
     out: &mut dyn Write,
 ) -> Result<(), GcodeWriteError> {
+    write_program_indexed(design, job, out, None)
+}
+
+/// A whole G-code program in memory, with the path point each line belongs to: what a printer
+/// host streams and shows (the nozzle at the line being printed) without reading the G-code back.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Program {
+    pub text: String,
+    /// `point_of_line[j]`: index (into the job's toolpath points) of the point the nozzle has
+    /// reached once text line j has run: 0 up to and including the approach, the point a `G1`
+    /// moves to, the last point from the exit on.
+    pub point_of_line: Vec<u32>,
+}
+
+/// The program of a job, with its line → path point index (see [`Program`]).
+pub fn program(design: &Design, job: &PrintJob) -> Result<Program, GcodeWriteError> {
+    let mut bytes = Vec::new();
+    let mut index = Vec::new();
+    write_program_indexed(design, job, &mut bytes, Some(&mut index))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        GcodeWriteError::Io(io::Error::new(io::ErrorKind::InvalidData, e.to_string()))
+    })?;
+    // The exit, the end G-code and the closing comment: the path is done.
+    let last = job.toolpath.points.len().saturating_sub(1) as u32;
+    index.resize(text.lines().count(), last);
+    Ok(Program {
+        text,
+        point_of_line: index,
+    })
+}
+
+/// Records `lines` text lines, each at path point `point`, when an index is kept.
+#[inline]
+fn mark(index: &mut Option<&mut Vec<u32>>, lines: usize, point: usize) {
+    if let Some(v) = index {
+        v.extend(std::iter::repeat_n(point as u32, lines));
+    }
+}
+
+/// [`write_program`], optionally recording each line's path point into `index`.
+fn write_program_indexed(
+    design: &Design,
+    job: &PrintJob,
+    out: &mut dyn Write,
+    mut index: Option<&mut Vec<u32>>,
+) -> Result<(), GcodeWriteError> {
     let p = &design.printer;
     let tp = &job.toolpath;
-    let summary = summarize(design, job);
+    // The motion planner (the time estimate) and the thumbnails are independent: one core each.
+    let (summary, thumbnails) = std::thread::scope(|scope| {
+        let thumbnails = p.thumbnail.then(|| {
+            scope.spawn(|| {
+                let points: Vec<DVec3> = tp.points.iter().map(|q| q.pos).collect();
+                crate::thumbnail::header_blocks(&points)
+            })
+        });
+        let summary = summarize(design, job);
+        let thumbnails = thumbnails.map(|h| {
+            h.join()
+                .unwrap_or_else(|e: Box<dyn std::any::Any + Send>| std::panic::resume_unwind(e))
+        });
+        (summary, thumbnails)
+    });
     let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
         crate::templates::fill(t, &values)
@@ -364,9 +424,8 @@ pub fn write_program(
         );
         let _ = writeln!(head, "; total layers count = {layers_total}");
     }
-    if p.thumbnail {
-        let points: Vec<DVec3> = tp.points.iter().map(|q| q.pos).collect();
-        head.push_str(&crate::thumbnail::header_blocks(&points));
+    if let Some(blocks) = thumbnails {
+        head.push_str(&blocks);
     }
     head.push_str(&start);
     if !start.ends_with('\n') {
@@ -379,6 +438,7 @@ pub fn write_program(
         p.extrusion.gcode()
     );
     out.write_all(head.as_bytes())?;
+    mark(&mut index, head.matches('\n').count(), 0);
 
     let [ox, oy] = p.origin_offset();
     let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
@@ -400,73 +460,12 @@ pub fn write_program(
         buf.extend_from_slice(b"\nG0 Z");
         put_fixed(&mut buf, first.pos.z, 3);
         buf.push(b'\n');
+        mark(&mut index, 3, 0);
     }
-    let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
-    let e_per_mm3 = p.flow_multiplier / feed_area;
-    let mut e_total = 0.0;
-    let mut last_speed = f64::NAN;
-    // Progress: time into the print at each point (the nominal-speed estimate scaled to the
-    // planned total, so M73 counts down to the planned end).
-    let nominal: f64 = tp.print_time().max(1e-9);
-    let scale = summary.estimated_time_s / nominal;
-    let mut t_done = 0.0;
-    let mut last_percent = u64::MAX;
-    let mut next_layer = 0usize;
-    for i in 1..tp.points.len() {
-        let q = &tp.points[i];
-        if p.host_metadata || p.progress {
-            // The layer that starts at this point (or at the point before it: the first point
-            // of the path is where the approach ends).
-            while next_layer < tp.layer_starts.len() && tp.layer_starts[next_layer] <= i {
-                let n = next_layer + 1;
-                if p.host_metadata {
-                    buf.extend_from_slice(format!(";LAYER:{}\n", n - 1).as_bytes());
-                    match p.dialect {
-                        Dialect::Klipper => buf.extend_from_slice(
-                            format!("SET_PRINT_STATS_INFO CURRENT_LAYER={n}\n").as_bytes(),
-                        ),
-                        _ => buf.extend_from_slice(
-                            format!("M117 Layer {n}/{layers_total}\n").as_bytes(),
-                        ),
-                    }
-                }
-                next_layer += 1;
-            }
-            if p.progress {
-                let percent = ((t_done / nominal) * 100.0).floor().clamp(0.0, 100.0) as u64;
-                if percent != last_percent {
-                    let left_min = ((nominal - t_done) * scale / 60.0).ceil().max(0.0);
-                    buf.extend_from_slice(format!("M73 P{percent} R{left_min:.0}\n").as_bytes());
-                    last_percent = percent;
-                }
-            }
-        }
-        let prev = &tp.points[i - 1];
-        t_done += prev.pos.distance(q.pos) / q.speed;
-        let e = segment_volume(design, tp, i) * e_per_mm3;
-        buf.extend_from_slice(b"G1 ");
-        put_xy(&mut buf, q.pos);
-        buf.extend_from_slice(b" Z");
-        put_fixed(&mut buf, q.pos.z, 3);
-        buf.extend_from_slice(b" E");
-        match p.extrusion {
-            ExtrusionMode::Relative => put_fixed(&mut buf, e, 5),
-            ExtrusionMode::Absolute => {
-                e_total += e;
-                put_fixed(&mut buf, e_total, 5)
-            }
-        }
-        if q.speed != last_speed {
-            buf.extend_from_slice(b" F");
-            put_fixed(&mut buf, q.speed * 60.0, 1);
-            last_speed = q.speed;
-        }
-        buf.push(b'\n');
-        if buf.len() > (1 << 16) - 256 {
-            out.write_all(&buf)?;
-            buf.clear();
-        }
-    }
+    out.write_all(&buf)?;
+    buf.clear();
+    let body = BodyWriter::new(design, tp, summary.estimated_time_s, layers_total);
+    body.write(out, &mut index)?;
     if !tp.points.is_empty() {
         buf.extend_from_slice(b"G0 Z");
         put_fixed(&mut buf, z_out, 3);
@@ -484,6 +483,225 @@ pub fn write_program(
     buf.extend_from_slice(b"; end\n");
     out.write_all(&buf)?;
     Ok(())
+}
+
+/// Points formatted per chunk; two chunks at a time go to the two threads (bounded memory: a
+/// few tens of MB whatever the path length).
+const BODY_CHUNK: usize = 128 * 1024;
+
+/// Where the body's running sums stand just before path point `i` is written.
+#[derive(Debug, Clone, Copy)]
+struct BodyState {
+    /// Print time at nominal speeds up to point i − 1, s.
+    t_done: f64,
+    /// Cumulative E up to point i − 1 (absolute mode).
+    e_total: f64,
+    /// Feed rate last written (NaN before the first).
+    last_speed: f64,
+    /// Progress percent last written (`u64::MAX` before the first).
+    last_percent: u64,
+    /// Next entry of `layer_starts` to announce.
+    next_layer: usize,
+}
+
+/// The path part of the program: one `G1` per point with its E and, where they change, the
+/// feed rate, the layer messages and the M73 progress. Chunks of points are formatted on both
+/// cores; the running sums are carried from chunk to chunk in the order the sequential loop adds
+/// them, so the text is byte for byte the same as written on one core.
+struct BodyWriter<'a> {
+    design: &'a Design,
+    tp: &'a Toolpath,
+    origin: [f64; 2],
+    e_per_mm3: f64,
+    /// Print time at nominal speeds (the M73 percentages are of it), s.
+    nominal: f64,
+    /// Planned over nominal time: M73's minutes left count down to the planned end.
+    scale: f64,
+    layers_total: usize,
+}
+
+impl<'a> BodyWriter<'a> {
+    fn new(design: &'a Design, tp: &'a Toolpath, planned_s: f64, layers_total: usize) -> Self {
+        let p = &design.printer;
+        let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
+        let nominal = tp.print_time().max(1e-9);
+        BodyWriter {
+            design,
+            tp,
+            origin: p.origin_offset(),
+            e_per_mm3: p.flow_multiplier / feed_area,
+            nominal,
+            scale: planned_s / nominal,
+            layers_total,
+        }
+    }
+
+    fn percent(&self, t_done: f64) -> u64 {
+        ((t_done / self.nominal) * 100.0).floor().clamp(0.0, 100.0) as u64
+    }
+
+    /// Writes points 1 .. n, chunk by chunk, two chunks at a time in parallel.
+    fn write(&self, out: &mut dyn Write, index: &mut Option<&mut Vec<u32>>) -> io::Result<()> {
+        let n = self.tp.points.len();
+        if n < 2 {
+            return Ok(());
+        }
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |t| t.get())
+            .clamp(1, 2);
+        let mut state = BodyState {
+            t_done: 0.0,
+            e_total: 0.0,
+            last_speed: f64::NAN,
+            last_percent: u64::MAX,
+            next_layer: 0,
+        };
+        let mut start = 1;
+        while start < n {
+            // The ranges of this round and the state at the start of each.
+            let mut ranges = Vec::with_capacity(threads);
+            for _ in 0..threads {
+                if start >= n {
+                    break;
+                }
+                let end = (start + BODY_CHUNK).min(n);
+                ranges.push((start..end, state));
+                state = self.advance(state, start..end);
+                start = end;
+            }
+            let want_index = index.is_some();
+            let parts: Vec<(Vec<u8>, Vec<u32>)> = if ranges.len() == 1 || n < 4096 {
+                ranges
+                    .into_iter()
+                    .map(|(r, st)| self.format(r, st, want_index))
+                    .collect()
+            } else {
+                std::thread::scope(|scope| {
+                    let handles: Vec<_> = ranges
+                        .into_iter()
+                        .map(|(r, st)| scope.spawn(move || self.format(r, st, want_index)))
+                        .collect();
+                    handles
+                        .into_iter()
+                        .map(|h| {
+                            h.join().unwrap_or_else(
+                                |e: Box<dyn std::any::Any + Send>| std::panic::resume_unwind(e),
+                            )
+                        })
+                        .collect()
+                })
+            };
+            for (text, lines) in parts {
+                out.write_all(&text)?;
+                if let Some(v) = index.as_deref_mut() {
+                    v.extend_from_slice(&lines);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The state after points `range` (the sums only: no text).
+    fn advance(&self, mut st: BodyState, range: std::ops::Range<usize>) -> BodyState {
+        let (p, tp) = (&self.design.printer, self.tp);
+        let mut percent_before = None;
+        for i in range {
+            let q = &tp.points[i];
+            percent_before = Some(st.t_done);
+            st.t_done += tp.points[i - 1].pos.distance(q.pos) / q.speed;
+            if p.extrusion == ExtrusionMode::Absolute {
+                st.e_total += segment_volume(self.design, tp, i) * self.e_per_mm3;
+            }
+            st.last_speed = q.speed;
+            while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
+                st.next_layer += 1;
+            }
+        }
+        if p.progress
+            && let Some(t) = percent_before
+        {
+            st.last_percent = self.percent(t);
+        }
+        st
+    }
+
+    /// Formats points `range` starting from `st`; with `want_index`, each line's path point.
+    fn format(
+        &self,
+        range: std::ops::Range<usize>,
+        mut st: BodyState,
+        want_index: bool,
+    ) -> (Vec<u8>, Vec<u32>) {
+        let (p, tp) = (&self.design.printer, self.tp);
+        let [ox, oy] = self.origin;
+        let mut buf: Vec<u8> = Vec::with_capacity(range.len() * 48);
+        let mut lines: Vec<u32> = Vec::new();
+        let mark = |lines: &mut Vec<u32>, count: usize, point: usize| {
+            if want_index {
+                lines.extend(std::iter::repeat_n(point as u32, count));
+            }
+        };
+        for i in range {
+            let q = &tp.points[i];
+            if p.host_metadata || p.progress {
+                // The layer that starts at this point (or at the point before it: the first
+                // point of the path is where the approach ends).
+                while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
+                    let n = st.next_layer + 1;
+                    if p.host_metadata {
+                        mark(&mut lines, 2, i - 1);
+                        buf.extend_from_slice(format!(";LAYER:{}\n", n - 1).as_bytes());
+                        match p.dialect {
+                            Dialect::Klipper => buf.extend_from_slice(
+                                format!("SET_PRINT_STATS_INFO CURRENT_LAYER={n}\n").as_bytes(),
+                            ),
+                            _ => buf.extend_from_slice(
+                                format!("M117 Layer {n}/{}\n", self.layers_total).as_bytes(),
+                            ),
+                        }
+                    }
+                    st.next_layer += 1;
+                }
+                if p.progress {
+                    let percent = self.percent(st.t_done);
+                    if percent != st.last_percent {
+                        mark(&mut lines, 1, i - 1);
+                        let left_min =
+                            ((self.nominal - st.t_done) * self.scale / 60.0).ceil().max(0.0);
+                        buf.extend_from_slice(
+                            format!("M73 P{percent} R{left_min:.0}\n").as_bytes(),
+                        );
+                        st.last_percent = percent;
+                    }
+                }
+            }
+            let prev = &tp.points[i - 1];
+            st.t_done += prev.pos.distance(q.pos) / q.speed;
+            let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
+            buf.extend_from_slice(b"G1 X");
+            put_fixed(&mut buf, q.pos.x - ox, 3);
+            buf.extend_from_slice(b" Y");
+            put_fixed(&mut buf, q.pos.y - oy, 3);
+            buf.extend_from_slice(b" Z");
+            put_fixed(&mut buf, q.pos.z, 3);
+            buf.extend_from_slice(b" E");
+            match p.extrusion {
+                ExtrusionMode::Relative => put_fixed(&mut buf, e, 5),
+                ExtrusionMode::Absolute => {
+                    st.e_total += e;
+                    put_fixed(&mut buf, st.e_total, 5)
+                }
+            }
+            if q.speed != st.last_speed {
+                buf.extend_from_slice(b" F");
+                put_fixed(&mut buf, q.speed * 60.0, 1);
+                st.last_speed = q.speed;
+            }
+            buf.push(b'\n');
+            mark(&mut lines, 1, i);
+        }
+        (buf, lines)
+    }
 }
 
 /// Two-digit pairs "00" … "99", for writing integers two digits per division.
@@ -545,6 +763,43 @@ mod tests {
         let mut b = Vec::new();
         put_fixed(&mut b, v, d);
         String::from_utf8(b).unwrap()
+    }
+
+    /// The program's line index names, for every line that moves the nozzle along the path, the
+    /// point that line moves to (read back from the text); the text is the file's, byte for byte.
+    #[test]
+    fn every_path_line_carries_its_point() {
+        for profile in ["", "profile = \"klipper-paste-delta\"\n"] {
+            let d = crate::load::parse_design(&format!(
+                "version = 1\n[printer]\n{profile}[shape]\nheight = 20.0\nsamples = 60\nbase_layers = 1\n\
+                 lower = {{ type = \"circle\", radius = 30.0 }}\nupper = {{ type = \"circle\", radius = 30.0 }}\n"
+            ))
+            .unwrap();
+            let job = crate::run(&d).unwrap();
+            let prog = program(&d, &job).unwrap();
+            let mut file = Vec::new();
+            write_gcode(&d, &job, &mut file).unwrap();
+            assert_eq!(prog.text.as_bytes(), &file[..]);
+            assert_eq!(prog.point_of_line.len(), prog.text.lines().count());
+            let [ox, oy] = d.printer.origin_offset();
+            let mut moves = 0;
+            let mut last = 0;
+            for (line, &point) in prog.text.lines().zip(&prog.point_of_line) {
+                assert!(point >= last, "the index never goes back");
+                last = point;
+                let Some(rest) = line.strip_prefix("G1 X") else {
+                    continue;
+                };
+                let words: Vec<&str> = rest.split(' ').collect();
+                let x: f64 = words[0].parse().unwrap();
+                let y: f64 = words[1].trim_start_matches('Y').parse().unwrap();
+                let q = job.toolpath.points[point as usize].pos;
+                assert!((q.x - ox - x).abs() < 1e-3 && (q.y - oy - y).abs() < 1e-3, "{line}");
+                moves += 1;
+            }
+            assert_eq!(moves, job.toolpath.points.len() - 1);
+            assert_eq!(last as usize, job.toolpath.points.len() - 1);
+        }
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! Clayloft core: from a design file to a single spiral G-code path, without a window.
 //!
 //! The pipeline, in order (each stage a function from plain data to plain data):
-//! 1. [`load`] reads and [`validate`]s a [`design::Design`] (SPEC §6), with the printer
+//! 1. [`load`] reads and [`validate`]s a [`design::Design`] (SPEC §6; each number's range,
+//!    unit and meaning once, in [`fields`]), with the printer
 //!    [`profile`] it names (SPEC §12);
 //! 2. [`contour`] builds the two closed curves ([`spline`] for user splines, [`trace`] for
 //!    pictures, [`svg`] for drawings, through [`outline`]), [`align`] puts their
@@ -24,6 +25,7 @@ pub mod constraint;
 pub mod contour;
 pub mod control;
 pub mod design;
+pub mod fields;
 pub mod gcode;
 pub mod geometry;
 pub mod interp;

@@ -2,6 +2,7 @@
 //! can do. Each failure names the field (as a dotted path, e.g. `printer.layer_height`) and why.
 
 use crate::design::{BedShape, ContourSpec, DESIGN_VERSION, Design, Printer, Wave};
+use crate::fields::{self, MAX_LENGTH};
 
 /// A problem with one field of a design. `field` is a dotted path such as
 /// `control.vertical[1].points[2]`; the loader turns it into a line number.
@@ -28,8 +29,6 @@ pub const MAX_SAMPLES: usize = 100_000;
 /// 720 × 300 benchmark vessel, a few hundred MB of working memory; beyond it a typo (a layer
 /// height of 0.0001, a huge foot with a fine bead) is an error instead of an exhausted machine.
 pub const MAX_PATH_POINTS: usize = 4_000_000;
-/// Largest size of anything (bed, height, offsets), mm: 10 m.
-const MAX_LENGTH: f64 = 10_000.0;
 
 type Check = Result<(), FieldError>;
 
@@ -104,41 +103,37 @@ pub fn validate_printer(p: &Printer) -> Check {
                 "a round bed needs printer.bed_diameter (mm)",
             ));
         };
-        positive("printer.bed_diameter", dia, "mm")?;
+        fields::check("printer.bed_diameter", dia)?;
     } else if p.bed_diameter.is_some() {
         return Err(FieldError::new(
             "printer.bed_diameter",
             "is for round beds; set printer.bed_shape = \"circle\" or give bed_x and bed_y",
         ));
     }
-    positive("printer.bed_x", p.bed_x, "mm")?;
-    positive("printer.bed_y", p.bed_y, "mm")?;
-    positive("printer.max_z", p.max_z, "mm")?;
-    positive("printer.nozzle_diameter", p.nozzle_diameter, "mm")?;
-    positive("printer.line_width", p.line_width, "mm")?;
-    in_range(
-        "printer.line_width",
-        p.line_width,
-        0.1,
-        50.0,
-        "a bead width in mm",
-    )?;
-    positive("printer.min_layer_height", p.min_layer_height, "mm")?;
-    positive("printer.max_layer_height", p.max_layer_height, "mm")?;
-    in_range(
-        "printer.min_layer_height",
-        p.min_layer_height,
-        0.01,
-        50.0,
-        "a layer of clay in mm",
-    )?;
-    in_range(
-        "printer.max_layer_height",
-        p.max_layer_height,
-        0.01,
-        50.0,
-        "a layer of clay in mm",
-    )?;
+    // Every plain number against its one range (crate::fields), then the relations.
+    for (path, v) in [
+        ("printer.bed_x", p.bed_x),
+        ("printer.bed_y", p.bed_y),
+        ("printer.max_z", p.max_z),
+        ("printer.nozzle_diameter", p.nozzle_diameter),
+        ("printer.line_width", p.line_width),
+        ("printer.min_layer_height", p.min_layer_height),
+        ("printer.max_layer_height", p.max_layer_height),
+        ("printer.layer_height", p.layer_height),
+        ("printer.nozzle_length", p.nozzle_length),
+        ("printer.max_overhang_deg", p.max_overhang_deg),
+        ("printer.max_acceleration", p.max_acceleration),
+        ("printer.junction_deviation", p.junction_deviation),
+        ("printer.print_speed", p.print_speed),
+        ("printer.travel_speed", p.travel_speed),
+        ("printer.feed_diameter", p.feed_diameter),
+        ("printer.flow_multiplier", p.flow_multiplier),
+        ("printer.min_layer_time", p.min_layer_time),
+        ("printer.flow_ramp_start", p.flow_ramp_start),
+        ("printer.flow_ramp_end", p.flow_ramp_end),
+    ] {
+        fields::check(path, v)?;
+    }
     if p.max_layer_height < p.min_layer_height {
         return Err(FieldError::new(
             "printer.max_layer_height",
@@ -148,7 +143,6 @@ pub fn validate_printer(p: &Printer) -> Check {
             ),
         ));
     }
-    finite("printer.layer_height", p.layer_height)?;
     if p.layer_height < p.min_layer_height || p.layer_height > p.max_layer_height {
         return Err(FieldError::new(
             "printer.layer_height",
@@ -158,60 +152,6 @@ pub fn validate_printer(p: &Printer) -> Check {
             ),
         ));
     }
-    positive("printer.nozzle_length", p.nozzle_length, "mm")?;
-    in_range(
-        "printer.max_overhang_deg",
-        p.max_overhang_deg,
-        1.0,
-        80.0,
-        "degrees from vertical",
-    )?;
-    in_range(
-        "printer.max_acceleration",
-        p.max_acceleration,
-        1.0,
-        100_000.0,
-        "mm/s²",
-    )?;
-    in_range(
-        "printer.junction_deviation",
-        p.junction_deviation,
-        0.0001,
-        10.0,
-        "mm (Marlin's range is 0.001 … 0.5)",
-    )?;
-    in_range("printer.print_speed", p.print_speed, 0.1, 1000.0, "mm/s")?;
-    in_range("printer.travel_speed", p.travel_speed, 0.1, 1000.0, "mm/s")?;
-    positive("printer.feed_diameter", p.feed_diameter, "mm")?;
-    in_range(
-        "printer.flow_multiplier",
-        p.flow_multiplier,
-        0.01,
-        10.0,
-        "a factor on the extruded volume",
-    )?;
-    in_range(
-        "printer.min_layer_time",
-        p.min_layer_time,
-        0.0,
-        3600.0,
-        "seconds per revolution",
-    )?;
-    in_range(
-        "printer.flow_ramp_start",
-        p.flow_ramp_start,
-        0.0,
-        MAX_LENGTH,
-        "mm of path",
-    )?;
-    in_range(
-        "printer.flow_ramp_end",
-        p.flow_ramp_end,
-        0.0,
-        MAX_LENGTH,
-        "mm of path",
-    )?;
-
     Ok(())
 }
 
@@ -230,7 +170,7 @@ pub fn validate(d: &Design) -> Check {
     validate_printer(&d.printer)?;
     let p = &d.printer;
     let s = &d.shape;
-    positive("shape.height", s.height, "mm")?;
+    fields::check("shape.height", s.height)?;
     if s.height > p.max_z {
         return Err(FieldError::new(
             "shape.height",

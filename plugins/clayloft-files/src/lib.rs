@@ -1,6 +1,7 @@
 //! Files in the app: open and save design files (SPEC §6; a saved file loads back identical),
-//! export G-code and STL with the same writers as the command line, and autosave so that no edit
-//! is lost if the program is killed.
+//! export G-code and STL with the same writers as the command line — of the job the core's
+//! session already computed, written on a background thread — and autosave so that no edit is
+//! lost if the program is killed.
 //!
 //! Autosave: after every change the design is written (atomically) to the autosave file of the
 //! document — `<autosave dir>/<file stem>.autosave.toml`, the directory being
@@ -9,12 +10,14 @@
 //! removes it.
 
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::Duration;
 
 use bevy::prelude::*;
-use clayloft_core::Design;
 use clayloft_core::atomic::write_atomically;
-use clayloft_model::{DesignDoc, ModelSystems};
+use clayloft_core::{Design, PrintJob};
+use clayloft_model::{DesignDoc, Engine, ModelSystems};
 
 /// What the user asked the files plugin to do.
 #[derive(Message, Debug, Clone, PartialEq)]
@@ -96,6 +99,7 @@ impl Plugin for FilesPlugin {
             app.insert_resource(Autosave::new(Autosave::default_dir()));
         }
         app.init_resource::<FileStatus>()
+            .init_resource::<Exports>()
             .add_message::<FileCommand>()
             .add_systems(
                 Update,
@@ -103,6 +107,7 @@ impl Plugin for FilesPlugin {
                     .chain()
                     .in_set(ModelSystems::Edit),
             )
+            .add_systems(Update, poll_exports)
             .add_systems(Update, write_autosave.after(ModelSystems::Recompute));
     }
 }
@@ -135,12 +140,11 @@ pub fn save_design(design: &Design, path: &Path) -> Result<Design, String> {
     }
 }
 
-/// Writes the G-code of a design, as `clayloft gcode` does.
-pub fn export_gcode(design: &Design, path: &Path) -> Result<String, String> {
-    let job = clayloft_core::run(design).map_err(|e| format!("{}: {e}", path.display()))?;
-    write_atomically(path, |w| clayloft_core::gcode::write_gcode(design, &job, w))
+/// Writes the G-code of a job, as `clayloft gcode` does.
+pub fn export_gcode(design: &Design, job: &PrintJob, path: &Path) -> Result<String, String> {
+    write_atomically(path, |w| clayloft_core::gcode::write_gcode(design, job, w))
         .map_err(|e| e.to_string())?;
-    let s = clayloft_core::gcode::summarize(design, &job);
+    let s = clayloft_core::gcode::summarize(design, job);
     Ok(format!(
         "wrote {} ({} points, {:.1} m of path)",
         path.display(),
@@ -149,12 +153,10 @@ pub fn export_gcode(design: &Design, path: &Path) -> Result<String, String> {
     ))
 }
 
-/// Writes the wall as a binary STL, as `clayloft stl` does.
-pub fn export_stl(design: &Design, path: &Path) -> Result<String, String> {
-    let surface = clayloft_core::pipeline::build_surface(design)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+/// Writes the printed wall of a job as a binary STL, as `clayloft stl` does.
+pub fn export_stl(design: &Design, job: &PrintJob, path: &Path) -> Result<String, String> {
     let mesh = clayloft_core::stl::wall_mesh(
-        &surface,
+        &job.surface,
         design.printer.line_width,
         design.shape.base_layers,
     );
@@ -169,11 +171,86 @@ pub fn export_stl(design: &Design, path: &Path) -> Result<String, String> {
     ))
 }
 
+/// Exports being written on background threads (the job is the session's: nothing is
+/// recomputed, and the UI never waits for the file).
+#[derive(Resource, Default)]
+pub struct Exports {
+    running: Vec<(PathBuf, Mutex<Receiver<Result<String, String>>>)>,
+}
+
+impl Exports {
+    /// Files still being written.
+    pub fn pending(&self) -> usize {
+        self.running.len()
+    }
+}
+
+/// The session's current job for the document's design, or why it is not exported.
+fn current_job(engine: &Engine, design: &Design, path: &Path) -> Result<PrintJob, String> {
+    engine
+        .current_job(design)
+        .map_err(|why| format!("{}: not exported, {why}", path.display()))
+}
+
+fn start_export(
+    exports: &mut Exports,
+    status: &mut FileStatus,
+    path: &Path,
+    job: Result<PrintJob, String>,
+    design: &Design,
+    write: fn(&Design, &PrintJob, &Path) -> Result<String, String>,
+) {
+    let job = match job {
+        Ok(j) => j,
+        Err(e) => return status.err(e),
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    let (design, file) = (design.clone(), path.to_path_buf());
+    std::thread::spawn(move || {
+        let _ = tx.send(write(&design, &job, &file));
+    });
+    exports.running.push((path.to_path_buf(), Mutex::new(rx)));
+    status.ok(format!("writing {} …", path.display()));
+}
+
+/// Reports finished exports; while any runs, asks for frames so that it is polled.
+fn poll_exports(
+    mut exports: ResMut<Exports>,
+    mut status: ResMut<FileStatus>,
+    redraw: Option<ResMut<Messages<bevy::window::RequestRedraw>>>,
+) {
+    if exports.running.is_empty() {
+        return;
+    }
+    exports.running.retain_mut(|(path, rx)| match rx.get_mut().map_or(Err(TryRecvError::Disconnected), |r| r.try_recv()) {
+        Ok(Ok(m)) => {
+            status.ok(m);
+            false
+        }
+        Ok(Err(e)) => {
+            status.err(e);
+            false
+        }
+        Err(TryRecvError::Empty) => true,
+        Err(TryRecvError::Disconnected) => {
+            status.err(format!("{}: the export stopped unexpectedly", path.display()));
+            false
+        }
+    });
+    if !exports.running.is_empty()
+        && let Some(mut redraw) = redraw
+    {
+        redraw.write(bevy::window::RequestRedraw);
+    }
+}
+
 fn run_file_commands(
     mut commands: MessageReader<FileCommand>,
     doc: Option<ResMut<DesignDoc>>,
     mut status: ResMut<FileStatus>,
     mut autosave: ResMut<Autosave>,
+    engine: Res<Engine>,
+    mut exports: ResMut<Exports>,
 ) {
     let Some(mut doc) = doc else { return };
     for c in commands.read() {
@@ -204,14 +281,14 @@ fn run_file_commands(
                     Err(e) => status.err(e),
                 }
             }
-            FileCommand::ExportGcode(path) => match export_gcode(&doc.design, path) {
-                Ok(m) => status.ok(m),
-                Err(e) => status.err(e),
-            },
-            FileCommand::ExportStl(path) => match export_stl(&doc.design, path) {
-                Ok(m) => status.ok(m),
-                Err(e) => status.err(e),
-            },
+            FileCommand::ExportGcode(path) => {
+                let job = current_job(&engine, &doc.design, path);
+                start_export(&mut exports, &mut status, path, job, &doc.design, export_gcode);
+            }
+            FileCommand::ExportStl(path) => {
+                let job = current_job(&engine, &doc.design, path);
+                start_export(&mut exports, &mut status, path, job, &doc.design, export_stl);
+            }
         }
     }
 }
@@ -384,6 +461,39 @@ mod tests {
         );
     }
 
+    /// Runs frames until the background exports are written (bounded).
+    fn finish_exports(app: &mut App) {
+        app.update();
+        for _ in 0..500 {
+            if app.world().resource::<Exports>().pending() == 0 {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+            app.update();
+        }
+        assert_eq!(app.world().resource::<Exports>().pending(), 0, "export still running");
+    }
+
+    /// An invalid design is not exported: the message says why, and no file appears.
+    #[test]
+    fn an_invalid_design_is_not_exported() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut app = app(dir.path());
+        let mut design = open_design(&design_path()).unwrap();
+        design.printer.line_width = -1.0;
+        app.insert_resource(DesignDoc { design, path: None });
+        app.update();
+        let g = dir.path().join("bad.gcode");
+        app.world_mut()
+            .resource_mut::<Messages<FileCommand>>()
+            .write(FileCommand::ExportGcode(g.clone()));
+        finish_exports(&mut app);
+        let status = app.world().resource::<FileStatus>().clone();
+        let m = status.message.unwrap();
+        assert!(status.is_error && m.contains("printer.line_width"), "{m}");
+        assert!(!g.exists());
+    }
+
     #[test]
     fn export_and_bad_paths_from_the_app() {
         let dir = tempfile::tempdir().unwrap();
@@ -397,7 +507,10 @@ mod tests {
         app.world_mut()
             .resource_mut::<Messages<FileCommand>>()
             .write(FileCommand::ExportGcode(g.clone()));
-        app.update();
+        finish_exports(&mut app);
+        let status = app.world().resource::<FileStatus>().clone();
+        assert!(!status.is_error, "{status:?}");
+        assert!(status.message.unwrap().starts_with("wrote"));
         let text = std::fs::read_to_string(&g).unwrap();
         let report = clayloft_core::check::check_gcode(
             &text,
@@ -412,7 +525,7 @@ mod tests {
         app.world_mut()
             .resource_mut::<Messages<FileCommand>>()
             .write(FileCommand::ExportStl(bad.clone()));
-        app.update();
+        finish_exports(&mut app);
         let status = app.world().resource::<FileStatus>().clone();
         assert!(status.is_error && status.message.unwrap().contains("missing-folder"));
         assert!(!bad.exists());

@@ -16,6 +16,21 @@ use crate::document::{DesignDoc, ModelStatus};
 #[derive(Resource, Debug, Default)]
 pub struct Engine(pub Session);
 
+impl Engine {
+    /// The session's job for exactly this design (what exports and the printer use: nothing is
+    /// recomputed), or why there is none in a sentence.
+    pub fn current_job(&self, design: &clayloft_core::Design) -> Result<clayloft_core::PrintJob, String> {
+        let session = &self.0;
+        if let Some(e) = session.error() {
+            return Err(format!("the design has an error: {e}"));
+        }
+        match (session.design(), session.job()) {
+            (Some(d), Some(job)) if d == design => Ok(job),
+            _ => Err("the design is still being computed".into()),
+        }
+    }
+}
+
 /// What the last recompute did, for tests, benchmarks and the status line.
 #[derive(Resource, Debug, Clone, Default, PartialEq)]
 pub struct RecomputeLog {

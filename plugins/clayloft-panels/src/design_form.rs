@@ -7,7 +7,7 @@ use clayloft_core::design::{
 };
 use clayloft_model::handles::HandleRole;
 
-use crate::widgets::{count, explain, number, point_list};
+use crate::widgets::{count, explain, field, number, point_list};
 
 pub fn design_form(ui: &mut egui::Ui, d: &mut Design, selected: Option<HandleRole>) {
     ui.horizontal(|ui| {
@@ -61,14 +61,7 @@ pub fn design_form(ui: &mut egui::Ui, d: &mut Design, selected: Option<HandleRol
 
 fn shape(ui: &mut egui::Ui, d: &mut Design) {
     let s = &mut d.shape;
-    number(
-        ui,
-        "Height",
-        &mut s.height,
-        "mm",
-        1.0..=2000.0,
-        "Height of the vessel from the bed to the rim.",
-    );
+    field(ui, "shape.height", &mut s.height);
     count(
         ui,
         "Samples",
@@ -632,142 +625,25 @@ fn printer(ui: &mut egui::Ui, d: &mut Design) {
         ui,
         "Defaults are the paper's clay printer. Layer limits keep the bead stacked; speeds set the print time.",
     );
-    number(
-        ui,
-        "Bed x",
-        &mut p.bed_x,
-        "mm",
-        10.0..=10_000.0,
-        "Bed size along x.",
-    );
-    number(
-        ui,
-        "Bed y",
-        &mut p.bed_y,
-        "mm",
-        10.0..=10_000.0,
-        "Bed size along y.",
-    );
-    number(
-        ui,
-        "Build height",
-        &mut p.max_z,
-        "mm",
-        10.0..=10_000.0,
-        "Highest the nozzle can go.",
-    );
-    number(
-        ui,
-        "Nozzle diameter",
-        &mut p.nozzle_diameter,
-        "mm",
-        0.1..=20.0,
-        "Opening of the nozzle.",
-    );
-    number(
-        ui,
-        "Line width",
-        &mut p.line_width,
-        "mm",
-        0.1..=50.0,
-        "Width of the clay bead: the wall is this thick.",
-    );
-    number(
-        ui,
-        "Layer height",
-        &mut p.layer_height,
-        "mm",
-        0.05..=20.0,
-        "Nominal height of each layer.",
-    );
-    number(
-        ui,
-        "Min layer height",
-        &mut p.min_layer_height,
-        "mm",
-        0.01..=20.0,
-        "Thinner layers smear the bead.",
-    );
-    number(
-        ui,
-        "Max layer height",
-        &mut p.max_layer_height,
-        "mm",
-        0.01..=20.0,
-        "Thicker layers do not bond.",
-    );
-    number(
-        ui,
-        "Nozzle length",
-        &mut p.nozzle_length,
-        "mm",
-        1.0..=500.0,
-        "Tube length below the holder: printed clay may rise at most this far above the tip.",
-    );
-    number(
-        ui,
-        "Max overhang",
-        &mut p.max_overhang_deg,
-        "°",
-        1.0..=89.0,
-        "Largest lean from vertical that clay holds without support.",
-    );
-    number(
-        ui,
-        "Print speed",
-        &mut p.print_speed,
-        "mm/s",
-        0.1..=500.0,
-        "Speed along the wall.",
-    );
-    number(
-        ui,
-        "Travel speed",
-        &mut p.travel_speed,
-        "mm/s",
-        0.1..=500.0,
-        "Approach and exit moves only.",
-    );
-    number(
-        ui,
-        "Feed diameter",
-        &mut p.feed_diameter,
-        "mm",
-        0.1..=100.0,
-        "Calibration of E: the extruder's equivalent filament diameter.",
-    );
-    number(
-        ui,
-        "Flow multiplier",
-        &mut p.flow_multiplier,
-        "×",
-        0.01..=10.0,
-        "Scales all extrusion.",
-    );
-    number(
-        ui,
-        "Min layer time",
-        &mut p.min_layer_time,
-        "s",
-        0.0..=600.0,
-        "Small layers slow down so the clay stiffens (0 = off).",
-    );
-    number(
-        ui,
-        "Flow ramp start",
-        &mut p.flow_ramp_start,
-        "mm",
-        0.0..=1000.0,
-        "Path length over which flow rises at the start.",
-    );
-    number(
-        ui,
-        "Flow ramp end",
-        &mut p.flow_ramp_end,
-        "mm",
-        0.0..=1000.0,
-        "Path length over which flow falls at the end.",
-    );
+    field(ui, "printer.bed_x", &mut p.bed_x);
+    field(ui, "printer.bed_y", &mut p.bed_y);
+    field(ui, "printer.max_z", &mut p.max_z);
+    field(ui, "printer.nozzle_diameter", &mut p.nozzle_diameter);
+    field(ui, "printer.line_width", &mut p.line_width);
+    field(ui, "printer.layer_height", &mut p.layer_height);
+    field(ui, "printer.min_layer_height", &mut p.min_layer_height);
+    field(ui, "printer.max_layer_height", &mut p.max_layer_height);
+    field(ui, "printer.nozzle_length", &mut p.nozzle_length);
+    field(ui, "printer.max_overhang_deg", &mut p.max_overhang_deg);
+    field(ui, "printer.print_speed", &mut p.print_speed);
+    field(ui, "printer.travel_speed", &mut p.travel_speed);
+    field(ui, "printer.max_acceleration", &mut p.max_acceleration);
+    field(ui, "printer.junction_deviation", &mut p.junction_deviation);
+    field(ui, "printer.feed_diameter", &mut p.feed_diameter);
+    field(ui, "printer.flow_multiplier", &mut p.flow_multiplier);
+    field(ui, "printer.min_layer_time", &mut p.min_layer_time);
+    field(ui, "printer.flow_ramp_start", &mut p.flow_ramp_start);
+    field(ui, "printer.flow_ramp_end", &mut p.flow_ramp_end);
     ui.horizontal(|ui| {
         ui.label("Extrusion")
             .on_hover_text("E values per move (M83) or cumulative (M82).");

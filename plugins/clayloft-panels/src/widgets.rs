@@ -29,6 +29,13 @@ pub fn number(
     });
 }
 
+/// A number of the design described once in the core ([`clayloft_core::fields`]): its label,
+/// unit, valid range and explanation are the validator's.
+pub fn field(ui: &mut egui::Ui, path: &str, v: &mut f64) {
+    let m = clayloft_core::fields::meta(path);
+    number(ui, m.label, v, m.unit, m.form_range(), m.help);
+}
+
 /// A whole number.
 pub fn count(
     ui: &mut egui::Ui,

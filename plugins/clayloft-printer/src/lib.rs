@@ -12,7 +12,7 @@ use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use clayloft_model::DesignDoc;
 use clayloft_replay::{Replay, ReplayPath};
-use clayloft_serial::line::commands;
+use clayloft_serial::line::strip;
 use clayloft_serial::link::{list_ports, open_port, run_job};
 use clayloft_serial::reply::Temperatures;
 use clayloft_serial::sender::State;
@@ -73,27 +73,21 @@ impl Plugin for PrinterPlugin {
     }
 }
 
-/// Toolpath point index of every command: the k-th extruding `G1` is point k.
-pub fn points_of_commands(cmds: &[String]) -> Vec<usize> {
-    let mut k = 0usize;
-    cmds.iter()
-        .map(|c| {
-            let here = k;
-            if c.starts_with("G1 ") && c.contains(" E") {
-                k += 1;
-            }
-            here
-        })
-        .collect()
-}
-
-/// Starts printing `design` on `port`: G-code from the core, streamed on a background thread.
-pub fn start_job(design: &clayloft_core::Design, port: &str, baud: u32) -> Result<Job, String> {
-    let job = clayloft_core::run(design).map_err(|e| e.to_string())?;
-    let mut bytes = Vec::new();
-    clayloft_core::gcode::write_gcode(design, &job, &mut bytes).map_err(|e| e.to_string())?;
-    let cmds = commands(&String::from_utf8_lossy(&bytes));
-    let point_of_command = points_of_commands(&cmds);
+/// Starts printing `job` (the session's, for `design`) on `port`: the core writes the program
+/// with each line's path point, and a background thread streams it.
+pub fn start_job(
+    design: &clayloft_core::Design,
+    job: &clayloft_core::PrintJob,
+    port: &str,
+    baud: u32,
+) -> Result<Job, String> {
+    let program = clayloft_core::gcode::program(design, job).map_err(|e| e.to_string())?;
+    let (cmds, point_of_command): (Vec<String>, Vec<usize>) = program
+        .text
+        .lines()
+        .zip(&program.point_of_line)
+        .filter_map(|(line, &point)| strip(line).map(|c| (c.to_string(), point as usize)))
+        .unzip();
     let mut sender =
         Sender::new(cmds, SenderConfig::default(), Instant::now()).map_err(|e| e.to_string())?;
     let mut link = open_port(port, baud)?;
@@ -191,6 +185,7 @@ fn draw_printer_window(
     mut contexts: EguiContexts,
     mut panel: ResMut<PrinterPanel>,
     doc: Option<Res<DesignDoc>>,
+    engine: Res<clayloft_model::Engine>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     if panel.job.is_some() {
@@ -229,7 +224,10 @@ fn draw_printer_window(
                 if ui.add_enabled(!running && !panel.port.is_empty(), egui::Button::new("▶ Print design")).clicked()
                     && let Some(doc) = &doc
                 {
-                    match start_job(&doc.design, &panel.port.clone(), panel.baud) {
+                    let started = engine
+                        .current_job(&doc.design)
+                        .and_then(|job| start_job(&doc.design, &job, &panel.port.clone(), panel.baud));
+                    match started {
                         Ok(job) => {
                             panel.job = Some(job);
                             panel.done = 0;
@@ -285,21 +283,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn commands_map_to_toolpath_points() {
-        let cmds: Vec<String> = [
-            "G21",
-            "G0 X1 Y1 Z1",
-            "G1 X2 Y1 E0.1 F600",
-            "G1 X3 Y1 E0.1",
-            "G0 Z20",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        assert_eq!(points_of_commands(&cmds), vec![0, 0, 0, 1, 2]);
-    }
-
-    #[test]
     fn a_job_streams_to_a_fake_printer_on_its_thread() {
         use clayloft_serial::fake::{FakePrinter, Faults};
         use clayloft_serial::link::serve_fake;
@@ -321,7 +304,12 @@ mod tests {
             "version = 1\n[shape]\nheight = 5.0\nsamples = 24\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
         )
         .unwrap();
-        let job = start_job(&design, &name, 115_200).unwrap();
+        let print = clayloft_core::run(&design).unwrap();
+        let job = start_job(&design, &print, &name, 115_200).unwrap();
+        // Every command carries its path point from the core's writer: in order, to the end.
+        let points = job.point_of_command.clone();
+        assert!(points.windows(2).all(|w| w[0] <= w[1]));
+        assert_eq!(*points.last().unwrap(), print.toolpath.points.len() - 1);
         let rx = job.events.lock().unwrap();
         let end = loop {
             match rx
@@ -337,5 +325,15 @@ mod tests {
         drop(job);
         let printer = fake.join().unwrap();
         assert!(printer.log.iter().filter(|c| c.starts_with("G1 ")).count() > 24 * 5);
+        // The printer executed exactly the commands the index covers; the k-th G1 it ran is
+        // the move to path point k.
+        assert_eq!(printer.log.len(), points.len());
+        let mut k = 0;
+        for (cmd, &p) in printer.log.iter().zip(&points) {
+            if cmd.starts_with("G1 ") {
+                k += 1;
+                assert_eq!(p, k, "{cmd}");
+            }
+        }
     }
 }

@@ -7,7 +7,7 @@ use bevy::picking::Pickable;
 use bevy::prelude::*;
 use bevy_panorbit_camera::PanOrbitCamera;
 use clayloft_model::coords::to_world;
-use clayloft_model::preview::wall_buffers;
+use clayloft_model::preview::{toolpath_line, wall_buffers};
 use clayloft_model::*;
 
 /// What the view shows; the panels toggle these.
@@ -265,15 +265,7 @@ fn rebuild_toolpath_lines(
         let _ = assets.insert(view.handle.id(), asset);
         return;
     }
-    let pts = &path.0.points;
-    let top = pts.iter().map(|p| p.pos.z).fold(1.0_f64, f64::max);
-    asset.linestrip_gradient(pts.iter().map(|p| {
-        let f = (p.pos.z / top) as f32;
-        (
-            to_world(p.pos),
-            Color::srgb(0.25 + 0.7 * f, 0.55 + 0.2 * (1.0 - f), 1.0 - 0.6 * f),
-        )
-    }));
+    asset.linestrip_gradient(toolpath_line(&path.0));
     let _ = assets.insert(view.handle.id(), asset);
 }
 
