@@ -171,11 +171,14 @@ pub fn export_stl(design: &Design, job: &PrintJob, path: &Path) -> Result<String
     ))
 }
 
+/// What an export thread reports: the status line's message, or the error.
+type ExportResult = Result<String, String>;
+
 /// Exports being written on background threads (the job is the session's: nothing is
 /// recomputed, and the UI never waits for the file).
 #[derive(Resource, Default)]
 pub struct Exports {
-    running: Vec<(PathBuf, Mutex<Receiver<Result<String, String>>>)>,
+    running: Vec<(PathBuf, Mutex<Receiver<ExportResult>>)>,
 }
 
 impl Exports {

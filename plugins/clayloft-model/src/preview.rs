@@ -100,6 +100,22 @@ impl WallBuffers {
     }
 }
 
+/// The spiral toolpath as a coloured line strip in world coordinates: blue at the foot to warm
+/// at the rim, so the climb of the spiral reads at a glance.
+pub fn toolpath_line(path: &clayloft_core::toolpath::Toolpath) -> Vec<(Vec3, Color)> {
+    let pts = &path.points;
+    let top = pts.iter().map(|p| p.pos.z).fold(1.0_f64, f64::max);
+    pts.iter()
+        .map(|p| {
+            let f = (p.pos.z / top) as f32;
+            (
+                to_world(p.pos),
+                Color::srgb(0.25 + 0.7 * f, 0.55 + 0.2 * (1.0 - f), 1.0 - 0.6 * f),
+            )
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -131,20 +147,4 @@ mod tests {
             assert!(radial.dot(Vec3::from_array(*nrm)) > 0.999, "{p:?} {nrm:?}");
         }
     }
-}
-
-/// The spiral toolpath as a coloured line strip in world coordinates: blue at the foot to warm
-/// at the rim, so the climb of the spiral reads at a glance.
-pub fn toolpath_line(path: &clayloft_core::toolpath::Toolpath) -> Vec<(Vec3, Color)> {
-    let pts = &path.points;
-    let top = pts.iter().map(|p| p.pos.z).fold(1.0_f64, f64::max);
-    pts.iter()
-        .map(|p| {
-            let f = (p.pos.z / top) as f32;
-            (
-                to_world(p.pos),
-                Color::srgb(0.25 + 0.7 * f, 0.55 + 0.2 * (1.0 - f), 1.0 - 0.6 * f),
-            )
-        })
-        .collect()
 }
