@@ -5,7 +5,8 @@
 //! Rendering is reactive, like a desktop application: a frame is drawn on input, and otherwise
 //! only while something moves — the replay plays (`clayloft-replay`), the camera eases to its
 //! target (`clayloft-view`), a flow simulation or a print streams (their windows ask egui for a
-//! repaint) — or every 5 s. Left alone, the app sleeps.
+//! repaint), an export or the autosave is pending (`clayloft-files`) — or once a minute. Left
+//! alone, the app sleeps.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -41,12 +42,23 @@ pub fn run(design: Design, path: PathBuf, screenshot: Option<ScreenshotRequest>)
         path: Some(path),
     })
     .add_plugins(ClayloftPlugins);
+    if std::env::var_os("CLAYLOFT_FRAME_LOG").is_some() {
+        app.add_systems(Last, log_frames);
+    }
     let screenshot_mode = screenshot.is_some();
     // A screenshot waits for frames to settle: it runs continuously until the picture is saved.
     app.insert_resource(if screenshot_mode {
         WinitSettings::continuous()
     } else {
-        WinitSettings::desktop_app()
+        // Woken by input and by what moves (see the module documentation); the timeouts only
+        // bound how stale a forgotten case could get. Under software rendering one frame of
+        // the default design costs ~0.8 s of processor time, so a 5 s wake-up would be 16 %.
+        WinitSettings {
+            focused_mode: bevy::winit::UpdateMode::reactive(std::time::Duration::from_secs(60)),
+            unfocused_mode: bevy::winit::UpdateMode::reactive_low_power(
+                std::time::Duration::from_secs(60),
+            ),
+        }
     });
     if let Some(req) = screenshot {
         // A screenshot shows the design file as it is, not an autosave.
@@ -62,6 +74,59 @@ pub fn run(design: Design, path: PathBuf, screenshot: Option<ScreenshotRequest>)
         AppExit::Success => ExitCode::SUCCESS,
         AppExit::Error(code) if screenshot_mode => ExitCode::from(code.get()),
         AppExit::Error(_) => ExitCode::from(1),
+    }
+}
+
+/// bevy_egui 0.42 hands egui a `ModifiersChanged` event every frame (`write_egui_input_system`,
+/// input.rs:1517), changed or not; egui takes any event as a reason to repaint at once, so the
+/// app would never sleep (measured: 193 % CPU idle under software rendering). The event is
+/// dropped when the modifiers are what they were.
+fn drop_unchanged_egui_modifiers(
+    mut inputs: Query<&mut bevy_egui::EguiInput>,
+    mut last: Local<Option<bevy_egui::egui::Modifiers>>,
+) {
+    for mut input in &mut inputs {
+        let before = *last;
+        input.0.events.retain(|e| match e {
+            bevy_egui::egui::Event::ModifiersChanged(m) => {
+                let changed = before != Some(*m);
+                *last = Some(*m);
+                changed
+            }
+            _ => true,
+        });
+    }
+}
+
+/// With `CLAYLOFT_FRAME_LOG` set: frames drawn and redraws asked for, every two seconds (to see
+/// that an idle app sleeps, and what keeps it awake when it does not).
+fn log_frames(
+    time: Res<Time<Real>>,
+    mut redraws: MessageReader<bevy::window::RequestRedraw>,
+    mut egui: bevy_egui::EguiContexts,
+    mut counts: Local<(u64, u64, u64, f64)>,
+) {
+    counts.0 += 1;
+    counts.1 += redraws.read().count() as u64;
+    if let Ok(ctx) = egui.ctx_mut()
+        && ctx.has_requested_repaint()
+    {
+        counts.2 += 1;
+        if counts.2 == 1 {
+            let events = ctx.input(|i| format!("{:?} pointer {:?}", i.raw.events, i.pointer.latest_pos()));
+            info!("egui repaint causes: {:?}; input: {events}", ctx.repaint_causes());
+        }
+    }
+    let now = time.elapsed_secs_f64();
+    if now - counts.3 >= 2.0 {
+        info!(
+            "frames: {} in {:.1} s, redraw requests: {}, egui repaint requests: {}",
+            counts.0,
+            now - counts.3,
+            counts.1,
+            counts.2
+        );
+        *counts = (0, 0, 0, now);
     }
 }
 
@@ -93,7 +158,13 @@ impl Plugin for ThirdPartyPlugins {
         app.add_plugins((
             bevy_egui::EguiPlugin::default(),
             bevy_panorbit_camera::PanOrbitCameraPlugin,
-        ));
+        ))
+        .add_systems(
+            PreUpdate,
+            drop_unchanged_egui_modifiers
+                .after(bevy_egui::EguiPreUpdateSet::ProcessInput)
+                .before(bevy_egui::EguiPreUpdateSet::BeginPass),
+        );
         clayloft_edit::drag::picking_setup(app);
     }
 }

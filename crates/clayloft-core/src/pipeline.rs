@@ -12,7 +12,7 @@ use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind, group_events};
 use crate::section::Section;
 use crate::shape::{LIMIT_MARGIN, ShapeModel};
-use crate::texture::apply_texture;
+use crate::texture::{apply_displacements, apply_texture};
 use crate::session::Session;
 use crate::toolpath::Toolpath;
 use crate::validate::FieldError;
@@ -63,23 +63,29 @@ pub fn build_surface(design: &Design) -> Result<Surface, FieldError> {
     let loft = LoftInput::from_design(design)?;
     let (model, findings) = ShapeModel::new(design, loft)?;
     let sections: Vec<Section> = (0..=model.layers).map(|k| model.section(k)).collect();
-    finish_surface(design, &model, sections, findings)
+    finish_surface(design, &model, sections, findings, None)
 }
 
 /// Stages 4–5 on the shaped sections `model.section(k)`: overhang correction, texture, metrics
-/// and the fit on the machine. The app calls this after recomputing only the sections an edit
-/// touched; `findings` are the layer plan's (from [`ShapeModel::new`]).
+/// and the fit on the machine. The session calls this after recomputing only the sections an
+/// edit touched; `findings` are the layer plan's (from [`ShapeModel::new`]); `displacements`
+/// the texture's for this grid if already known ([`crate::texture::displacements`]).
 pub fn finish_surface(
     design: &Design,
     model: &ShapeModel,
     mut sections: Vec<Section>,
     mut findings: Vec<Finding>,
+    displacements: Option<&[Vec<f64>]>,
 ) -> Result<Surface, FieldError> {
     let center = model.loft.center;
     findings.extend(correct_shape(design, &mut sections, 1));
     if let Some(tex) = &design.texture {
         let enforce = design.constraints.enforce;
-        let events = apply_texture(&mut sections, tex, overhang_tan_limit(design), enforce);
+        let tan = overhang_tan_limit(design);
+        let events = match displacements {
+            Some(disp) => apply_displacements(&mut sections, disp, tan, enforce),
+            None => apply_texture(&mut sections, tex, tan, enforce),
+        };
         if !events.is_empty() {
             let columns = events.len();
             let mut f = group_events(&events, FindingKind::Texture, enforce, usize::MAX, |mm| {

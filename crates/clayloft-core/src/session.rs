@@ -133,6 +133,14 @@ pub struct SurfaceKey {
     pub center_given: bool,
 }
 
+/// Inputs of the texture's displacement table: the texture and the section grid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextureKey {
+    pub texture: Texture,
+    pub samples: usize,
+    pub sections: usize,
+}
+
 /// Inputs of the spiral toolpath.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ToolpathKey {
@@ -176,6 +184,8 @@ pub struct Session {
     sections: Vec<Stage<SectionKey, Section>>,
     /// Bumped whenever any section is recomputed or the section count changes.
     sections_revision: u64,
+    /// The texture's displacements on the section grid (no shape input: kept while shaping).
+    texture: Stage<TextureKey, Vec<Vec<f64>>>,
     surface: Stage<SurfaceKey, Arc<Surface>>,
     toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
     /// The design and job of the last successful update.
@@ -311,7 +321,17 @@ impl Session {
         }
         done.sections = dirty;
 
-        // 4. Surface.
+        // 4. Surface (with the texture's displacements, kept while only the shape changes).
+        if let Some(tex) = &design.texture {
+            let key = TextureKey {
+                texture: tex.clone(),
+                samples: model.loft.samples(),
+                sections: count,
+            };
+            self.texture.refresh(key, || {
+                Ok(crate::texture::displacements(tex, model.loft.samples(), count))
+            })?;
+        }
         let p = &design.printer;
         let key = SurfaceKey {
             plan: plan_revision,
@@ -325,12 +345,17 @@ impl Session {
             center_given: design.shape.center.is_some(),
         };
         let sections = &self.sections;
+        let disp = design
+            .texture
+            .as_ref()
+            .and(self.texture.get())
+            .map(Vec::as_slice);
         done.surface = self.surface.refresh(key, || {
             let shaped: Vec<Section> = sections
                 .iter()
                 .map(|s| s.value.clone().unwrap_or_default())
                 .collect();
-            finish_surface(design, model, shaped, plan_findings.clone()).map(Arc::new)
+            finish_surface(design, model, shaped, plan_findings.clone(), disp).map(Arc::new)
         })?;
 
         // 5. Toolpath.

@@ -60,11 +60,29 @@ pub fn apply_texture(
     tan_limit: f64,
     enforce: bool,
 ) -> Vec<crate::report::PointEvent> {
-    let layers = sections.len().saturating_sub(1);
     let n = sections.first().map_or(0, |s| s.points.len());
-    let disp: Vec<Vec<f64>> = (0..sections.len())
+    let disp = displacements(tex, n, sections.len());
+    apply_displacements(sections, &disp, tan_limit, enforce)
+}
+
+/// The texture's displacement `disp[k][i]` of sample i on section k, for `count` sections of
+/// `n` samples: it depends on the texture and the grid only, not on the wall's shape, so the
+/// incremental engine keeps it while the shape is edited.
+pub fn displacements(tex: &Texture, n: usize, count: usize) -> Vec<Vec<f64>> {
+    let layers = count.saturating_sub(1);
+    (0..count)
         .map(|k| (0..n).map(|i| displacement(tex, i, k, layers)).collect())
-        .collect();
+        .collect()
+}
+
+/// [`apply_texture`] with the displacements given (from [`displacements`] for these sections).
+pub fn apply_displacements(
+    sections: &mut [crate::section::Section],
+    disp: &[Vec<f64>],
+    tan_limit: f64,
+    enforce: bool,
+) -> Vec<crate::report::PointEvent> {
+    let n = sections.first().map_or(0, |s| s.points.len());
     let normals: Vec<Vec<glam::DVec2>> = sections.iter().map(|s| s.normals()).collect();
     // Largest admissible scale per column, and the layer where it binds.
     let mut scale = vec![(1.0_f64, 0_usize); n];

@@ -333,15 +333,22 @@ fn write_autosave(
     time: Res<Time<Real>>,
     mut autosave: ResMut<Autosave>,
     mut status: ResMut<FileStatus>,
+    redraw: Option<ResMut<Messages<bevy::window::RequestRedraw>>>,
 ) {
     let Some(doc) = doc else { return };
     let now = time.elapsed();
     if autosave.written.as_ref() == Some(&doc.design) {
-        autosave.pending_since = None;
+        if autosave.pending_since.is_some() {
+            autosave.pending_since = None;
+        }
         return;
     }
     let since = *autosave.pending_since.get_or_insert(now);
     if now.saturating_sub(since) < autosave.delay {
+        // The app sleeps between inputs: ask for frames until the delay has passed.
+        if let Some(mut redraw) = redraw {
+            redraw.write(bevy::window::RequestRedraw);
+        }
         return;
     }
     let path = autosave.path_for(doc.path.as_deref());

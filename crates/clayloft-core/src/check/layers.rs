@@ -3,6 +3,8 @@
 
 use std::collections::HashMap;
 
+use foldhash::fast::FixedState;
+
 use glam::{DVec2, DVec3};
 
 use super::Limits;
@@ -30,17 +32,21 @@ const INSERTIONS_BASE: usize = 1 << 22;
 const CANDIDATES_PER_POINT: usize = 1024;
 const CANDIDATES_BASE: usize = 1 << 24;
 
+/// A grid cell: (x, y, z-band) indices.
+type CellKey = (i32, i32, i32);
+
 /// Spatial hash of path chords in (x, y, z-band) cells.
 struct ChordGrid {
     cell: f64,
     band: f64,
-    cells: HashMap<(i32, i32, i32), Vec<u32>>,
+    /// Chord ids per cell, ascending (chords are inserted in path order).
+    cells: HashMap<CellKey, Vec<u32>, FixedState>,
     /// Insertions left before the grid gives up (see [`INSERTIONS_PER_CHORD`]).
     budget: usize,
 }
 
 impl ChordGrid {
-    fn key(&self, p: DVec2, z: f64) -> (i32, i32, i32) {
+    fn key(&self, p: DVec2, z: f64) -> CellKey {
         (
             (p.x / self.cell).floor() as i32,
             (p.y / self.cell).floor() as i32,
@@ -144,17 +150,45 @@ pub(super) fn measure_layers(
     let mut grid = ChordGrid {
         cell: radius,
         band: limits.max_layer_height,
-        cells: HashMap::new(),
+        cells: HashMap::with_hasher(FixedState::default()),
         budget: INSERTIONS_BASE.saturating_add(INSERTIONS_PER_CHORD.saturating_mul(chords.len())),
     };
+    // Every chord goes into the grid first; a point's candidates are the chords that end at or
+    // before it (a prefix of each cell's ascending list), so the points can be searched in any
+    // order, on every core.
     let mut measurable = true;
-    let mut candidates_left =
-        CANDIDATES_BASE.saturating_add(CANDIDATES_PER_POINT.saturating_mul(v.len()));
+    let mut ends = Vec::with_capacity(chords.len());
+    for (id, &(ia, ib)) in chords.iter().enumerate() {
+        let (a, b) = (v[ia], v[ib]);
+        if measurable && inside(a) && inside(b) {
+            measurable = grid.insert(id as u32, a, b);
+        }
+        ends.push(ib);
+    }
     let mut cum = vec![0.0; v.len()];
     for j in 1..v.len() {
         cum[j] = cum[j - 1] + v[j - 1].distance(v[j]);
     }
     report.path_length_mm = cum[v.len() - 1];
+    let search = LayerSearch {
+        v,
+        chords: &chords,
+        ends: &ends,
+        cum: &cum,
+        grid: &grid,
+        radius,
+        gap,
+        below_tol,
+        reach,
+        half_bead: 0.5 * limits.line_width,
+        bed_layer: limits.max_layer_height + 0.01 * limits.max_layer_height + 0.002,
+        inside: &inside,
+    };
+    let below: Vec<Below> = if measurable {
+        search.all(CANDIDATES_BASE.saturating_add(CANDIDATES_PER_POINT.saturating_mul(v.len())))
+    } else {
+        Vec::new()
+    };
     let (mut thin, mut thick, mut lean, mut unsupported, mut collide) = (
         Tally::default(),
         Tally::default(),
@@ -164,7 +198,6 @@ pub(super) fn measure_layers(
     );
     report.min_layer_height = f64::INFINITY;
     let mut running_max_z = f64::NEG_INFINITY;
-    let mut pending = 0usize; // next chord to insert
     let layer_tol = 0.01 * limits.max_layer_height + 0.002;
     // Degrees: G-code coordinates are rounded to 1 µm and the lean is measured against polyline
     // segments; the seam step where the helix leaves the flat revolution leans up to ~2° more
@@ -172,14 +205,6 @@ pub(super) fn measure_layers(
     let angle_tol = 2.0;
     for j in 0..v.len() {
         let p = v[j];
-        // Every earlier chord is a candidate; the bead just laid is told apart below.
-        while pending < chords.len() && chords[pending].1 <= j {
-            let (a, b) = (v[chords[pending].0], v[chords[pending].1]);
-            if measurable && inside(a) && inside(b) {
-                measurable = grid.insert(pending as u32, a, b);
-            }
-            pending += 1;
-        }
         if running_max_z - p.z > report.max_rise_above_tip {
             report.max_rise_above_tip = running_max_z - p.z;
         }
@@ -192,100 +217,25 @@ pub(super) fn measure_layers(
             });
         }
         running_max_z = running_max_z.max(p.z);
-        if j == 0 || !measurable || !inside(p) {
-            continue;
-        }
-        // The topmost earlier layer below p within the search radius.
-        let pxy = p.truncate();
-        let (k_lo, k_hi) = (
-            grid.key(pxy - radius, p.z - reach),
-            grid.key(pxy + radius, p.z - below_tol),
-        );
-        let mut found: Vec<(f64, f64)> = Vec::new();
-        for x in k_lo.0..=k_hi.0 {
-            for y in k_lo.1..=k_hi.1 {
-                for z in k_lo.2..=k_hi.2 {
-                    let Some(cell) = grid.cells.get(&(x, y, z)) else {
-                        continue;
-                    };
-                    if cell.len() > candidates_left {
-                        measurable = false;
-                        break;
-                    }
-                    candidates_left -= cell.len();
-                    for &id in cell {
-                        let (ia, ib) = chords[id as usize];
-                        let (a, b) = (v[ia], v[ib]);
-                        // Distance across the segment's line, for feet of the perpendicular on
-                        // the segment or just past its ends; a segment entirely ahead of or
-                        // behind p along its own direction is beside p, not under it.
-                        let (a2, b2) = (a.truncate(), b.truncate());
-                        let ab = b2 - a2;
-                        let len2 = ab.length_squared();
-                        // A steep segment (rising more than it runs) is a step between layers,
-                        // not a layer to rest on.
-                        if (b.z - a.z).powi(2) > len2 {
-                            continue;
-                        }
-                        let f_line = if len2 > 0.0 {
-                            (pxy - a2).dot(ab) / len2
-                        } else {
-                            0.0
-                        };
-                        if !(-0.5..=1.5).contains(&f_line) {
-                            continue;
-                        }
-                        let (d_end, f) = point_segment_distance(pxy, a2, b2);
-                        let d = if len2 > 0.0 {
-                            ab.perp_dot(pxy - a2).abs() / len2.sqrt()
-                        } else {
-                            d_end
-                        };
-                        let zq = a.z + (b.z - a.z) * f;
-                        // The bead just laid: reached from p along an almost straight stretch of
-                        // path. Where the path has come back over itself (the next revolution,
-                        // the centre of a spiral base) the layer below is much nearer in XY than
-                        // along the path.
-                        let along = cum[j] - (cum[ia] + f * (cum[ib] - cum[ia]));
-                        if along < gap && d >= 0.5 * along {
-                            continue;
-                        }
-                        if d <= radius && zq <= p.z - below_tol && zq >= p.z - reach {
-                            found.push((zq, d));
-                        }
-                    }
-                }
-            }
-        }
         if !measurable {
             continue;
         }
-        // Support: the topmost layer within half a bead of p; failing that, the nearest layer.
-        let half_bead = 0.5 * limits.line_width;
-        let top_under = found
-            .iter()
-            .filter(|(_, d)| *d <= half_bead)
-            .map(|(z, _)| *z)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let (height, offset) = if top_under.is_finite() {
-            let offset = found
-                .iter()
-                .filter(|(z, _)| *z >= top_under - below_tol)
-                .map(|(_, d)| *d)
-                .fold(f64::INFINITY, f64::min);
-            (p.z - top_under, offset)
-        } else if let Some(&(z, d)) = found.iter().min_by(|a, b| a.1.total_cmp(&b.1)) {
-            (p.z - z, d)
-        } else if p.z <= limits.max_layer_height + layer_tol {
-            (p.z, 0.0) // on the bed
-        } else {
-            unsupported.add(p.z, lines[j]);
-            report.events.push(PathEvent {
-                line: lines[j],
-                what: UNSUPPORTED,
-                value: p.z,
-            });
-            continue;
+        let (height, offset) = match below[j] {
+            Below::Skipped => continue,
+            Below::Unmeasurable => {
+                measurable = false;
+                continue;
+            }
+            Below::Unsupported => {
+                unsupported.add(p.z, lines[j]);
+                report.events.push(PathEvent {
+                    line: lines[j],
+                    what: UNSUPPORTED,
+                    value: p.z,
+                });
+                continue;
+            }
+            Below::Layer { height, offset } => (height, offset),
         };
         report.min_layer_height = report.min_layer_height.min(height);
         report.max_layer_height = report.max_layer_height.max(height);
@@ -362,4 +312,218 @@ pub(super) fn measure_layers(
             limits.nozzle_length
         ),
     );
+}
+
+/// The grid cells around the last point searched (reused while the next point's box of cells
+/// is the same).
+#[derive(Default)]
+struct NearCells<'g> {
+    bounds: Option<(CellKey, CellKey)>,
+    cells: Vec<&'g Vec<u32>>,
+}
+
+/// What lies below one path point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Below {
+    /// The first point, or a point outside the machine: not searched.
+    Skipped,
+    /// The candidate budget ran out here.
+    Unmeasurable,
+    /// Nothing printed within reach and not on the bed.
+    Unsupported,
+    /// The layer it rests on: its height above it and the XY offset from its bead, mm.
+    Layer { height: f64, offset: f64 },
+}
+
+/// The search for the layer below each point (read-only: shared by the threads).
+struct LayerSearch<'a, F: Fn(DVec3) -> bool + Sync> {
+    v: &'a [DVec3],
+    chords: &'a [(usize, usize)],
+    /// Last point of each chord: chord c is a candidate for point j when `ends[c] <= j`.
+    ends: &'a [usize],
+    /// Path length up to each point, mm.
+    cum: &'a [f64],
+    grid: &'a ChordGrid,
+    radius: f64,
+    gap: f64,
+    below_tol: f64,
+    reach: f64,
+    half_bead: f64,
+    /// Highest a point may be and still rest on the bed, mm.
+    bed_layer: f64,
+    inside: &'a F,
+}
+
+impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
+    /// Every point, split over the machine's cores; each part gets its share of the budget.
+    fn all(&self, budget: usize) -> Vec<Below> {
+        let n = self.v.len();
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |t| t.get())
+            .clamp(1, 8);
+        if threads < 2 || n < 20_000 {
+            return self.range(0..n, budget);
+        }
+        let chunk = n.div_ceil(threads);
+        let share = budget / threads;
+        std::thread::scope(|scope| {
+            let parts: Vec<_> = (0..n)
+                .step_by(chunk)
+                .map(|start| scope.spawn(move || self.range(start..(start + chunk).min(n), share)))
+                .collect();
+            parts
+                .into_iter()
+                .flat_map(|h| {
+                    h.join().unwrap_or_else(|e: Box<dyn std::any::Any + Send>| {
+                        std::panic::resume_unwind(e)
+                    })
+                })
+                .collect()
+        })
+    }
+
+    /// Points `range`, with `budget` candidate chords to examine in all; once it is spent the
+    /// rest are unmeasurable.
+    fn range(&self, range: std::ops::Range<usize>, mut budget: usize) -> Vec<Below> {
+        let mut out = Vec::with_capacity(range.len());
+        let mut found: Vec<(f64, f64)> = Vec::new();
+        let mut near = NearCells::default();
+        let mut spent = false;
+        for j in range {
+            if spent {
+                out.push(Below::Unmeasurable);
+                continue;
+            }
+            let b = self.point(j, &mut found, &mut near, &mut budget);
+            spent = b == Below::Unmeasurable;
+            out.push(b);
+        }
+        out
+    }
+
+    /// The topmost earlier layer below point j within the search radius.
+    fn point<'g>(
+        &'g self,
+        j: usize,
+        found: &mut Vec<(f64, f64)>,
+        near: &mut NearCells<'g>,
+        budget: &mut usize,
+    ) -> Below {
+        let p = self.v[j];
+        if j == 0 || !(self.inside)(p) {
+            return Below::Skipped;
+        }
+        let (radius, below_tol, reach) = (self.radius, self.below_tol, self.reach);
+        let grid = self.grid;
+        let pxy = p.truncate();
+        let (k_lo, k_hi) = (
+            grid.key(pxy - radius, p.z - reach),
+            grid.key(pxy + radius, p.z - below_tol),
+        );
+        found.clear();
+        // Consecutive points mostly share their box of cells: look the cells up once per box.
+        if near.bounds != Some((k_lo, k_hi)) {
+            near.bounds = Some((k_lo, k_hi));
+            near.cells.clear();
+            for x in k_lo.0..=k_hi.0 {
+                for y in k_lo.1..=k_hi.1 {
+                    for z in k_lo.2..=k_hi.2 {
+                        if let Some(cell) = grid.cells.get(&(x, y, z)) {
+                            near.cells.push(cell);
+                        }
+                    }
+                }
+            }
+        }
+        let (z_lo, z_hi) = (p.z - reach, p.z - below_tol);
+        {
+            {
+                for cell in &near.cells {
+                    // The chords laid before p: a prefix of the ascending ids.
+                    let earlier = cell.partition_point(|&id| self.ends[id as usize] <= j);
+                    let cell = &cell[..earlier];
+                    if cell.len() > *budget {
+                        return Below::Unmeasurable;
+                    }
+                    *budget -= cell.len();
+                    for &id in cell {
+                        let (ia, ib) = self.chords[id as usize];
+                        let (a, b) = (self.v[ia], self.v[ib]);
+                        // Entirely above or below the heights a layer under p may have (the
+                        // bead just laid, mostly): no distance needed.
+                        if a.z.max(b.z) < z_lo || a.z.min(b.z) > z_hi {
+                            continue;
+                        }
+                        // Distance across the segment's line, for feet of the perpendicular on
+                        // the segment or just past its ends; a segment entirely ahead of or
+                        // behind p along its own direction is beside p, not under it.
+                        let (a2, b2) = (a.truncate(), b.truncate());
+                        let ab = b2 - a2;
+                        let len2 = ab.length_squared();
+                        // A steep segment (rising more than it runs) is a step between layers,
+                        // not a layer to rest on.
+                        if (b.z - a.z).powi(2) > len2 {
+                            continue;
+                        }
+                        let f_line = if len2 > 0.0 {
+                            (pxy - a2).dot(ab) / len2
+                        } else {
+                            0.0
+                        };
+                        if !(-0.5..=1.5).contains(&f_line) {
+                            continue;
+                        }
+                        let (d_end, f) = point_segment_distance(pxy, a2, b2);
+                        let d = if len2 > 0.0 {
+                            ab.perp_dot(pxy - a2).abs() / len2.sqrt()
+                        } else {
+                            d_end
+                        };
+                        let zq = a.z + (b.z - a.z) * f;
+                        // The bead just laid: reached from p along an almost straight stretch of
+                        // path. Where the path has come back over itself (the next revolution,
+                        // the centre of a spiral base) the layer below is much nearer in XY than
+                        // along the path.
+                        let cum = self.cum;
+                        let along = cum[j] - (cum[ia] + f * (cum[ib] - cum[ia]));
+                        if along < self.gap && d >= 0.5 * along {
+                            continue;
+                        }
+                        if d <= radius && zq <= z_hi && zq >= z_lo {
+                            found.push((zq, d));
+                        }
+                    }
+                }
+            }
+        }
+        // Support: the topmost layer within half a bead of p; failing that, the nearest layer.
+        let top_under = found
+            .iter()
+            .filter(|(_, d)| *d <= self.half_bead)
+            .map(|(z, _)| *z)
+            .fold(f64::NEG_INFINITY, f64::max);
+        if top_under.is_finite() {
+            let offset = found
+                .iter()
+                .filter(|(z, _)| *z >= top_under - below_tol)
+                .map(|(_, d)| *d)
+                .fold(f64::INFINITY, f64::min);
+            Below::Layer {
+                height: p.z - top_under,
+                offset,
+            }
+        } else if let Some(&(z, d)) = found.iter().min_by(|a, b| a.1.total_cmp(&b.1)) {
+            Below::Layer {
+                height: p.z - z,
+                offset: d,
+            }
+        } else if p.z <= self.bed_layer {
+            Below::Layer {
+                height: p.z,
+                offset: 0.0,
+            } // on the bed
+        } else {
+            Below::Unsupported
+        }
+    }
 }
