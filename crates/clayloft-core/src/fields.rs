@@ -136,6 +136,27 @@ pub const FIELDS: &[FieldMeta] = &[
         "Path length over which flow rises at the start."),
     field("printer.flow_ramp_end", "Flow ramp end", "mm", 0.0, MAX_LENGTH, false,
         "Path length over which flow falls at the end."),
+    // Contour sizes, for both contours (`shape.lower.radius`, `shape.upper.rx`, …): the entry
+    // is named by the last part of the path.
+    field("contour.radius", "Radius", "mm", 0.0, MAX_LENGTH, true,
+        "Distance from the centre to the curve (a polygon's corner, a rose's mean radius)."),
+    field("contour.rx", "Radius x", "mm", 0.0, MAX_LENGTH, true, "Semi-axis along x."),
+    field("contour.ry", "Radius y", "mm", 0.0, MAX_LENGTH, true, "Semi-axis along y."),
+    field("contour.outer_radius", "Outer radius", "mm", 0.0, MAX_LENGTH, true,
+        "Centre to a tip of the star."),
+    field("contour.inner_radius", "Inner radius", "mm", 0.0, MAX_LENGTH, true,
+        "Centre to a notch of the star."),
+    // Texture waves, for both directions (`texture.x.period`, `texture.y.amplitude`).
+    field("wave.period", "Period", "", 1e-3, 1e6, false,
+        "Length of one wave: samples around (x) or layers up (y)."),
+    field("wave.amplitude", "Amplitude", "mm", -100.0, 100.0, false,
+        "How far the surface moves along its normal."),
+    field("texture.phase_drift", "Phase drift", "samples/layer", -1e4, 1e4, false,
+        "How far the x wave shifts per layer: twists the pattern up the wall."),
+    field("texture.start", "Start", "", 0.0, 1.0, false,
+        "Height fraction where the texture begins."),
+    field("texture.end", "End", "", 0.0, 1.0, false,
+        "Height fraction where the texture ends."),
 ];
 
 /// The metadata of the field at `path`.
@@ -152,6 +173,15 @@ pub fn meta(path: &str) -> &'static FieldMeta {
 /// Checks `v` against the range of the field at `path`.
 pub fn check(path: &str, v: f64) -> Result<(), FieldError> {
     meta(path).check(v)
+}
+
+/// Checks `v` against the range of the shared entry `entry` (e.g. `contour.radius`), the error
+/// naming the actual field `path` (e.g. `shape.upper.radius`).
+pub fn check_as(entry: &str, path: &str, v: f64) -> Result<(), FieldError> {
+    meta(entry).check(v).map_err(|mut e| {
+        e.field = path.to_string();
+        e
+    })
 }
 
 #[cfg(test)]

@@ -43,23 +43,6 @@ fn finite(field: &str, v: f64) -> Check {
     }
 }
 
-fn positive(field: &str, v: f64, unit: &str) -> Check {
-    finite(field, v)?;
-    if v <= 0.0 {
-        return Err(FieldError::new(
-            field,
-            format!("must be greater than 0 {unit}, got {v}"),
-        ));
-    }
-    if v > MAX_LENGTH {
-        return Err(FieldError::new(
-            field,
-            format!("{v} {unit} is absurdly large (at most {MAX_LENGTH})"),
-        ));
-    }
-    Ok(())
-}
-
 fn count_in(field: String, v: usize, lo: usize, hi: usize) -> Check {
     if (lo..=hi).contains(&v) {
         Ok(())
@@ -324,15 +307,9 @@ pub fn validate(d: &Design) -> Check {
         if let Some(w) = &t.y {
             wave("texture.y", w)?;
         }
-        in_range(
-            "texture.phase_drift",
-            t.phase_drift,
-            -1e4,
-            1e4,
-            "samples per layer",
-        )?;
-        in_range("texture.start", t.start, 0.0, 1.0, "a height fraction")?;
-        in_range("texture.end", t.end, 0.0, 1.0, "a height fraction")?;
+        fields::check("texture.phase_drift", t.phase_drift)?;
+        fields::check("texture.start", t.start)?;
+        fields::check("texture.end", t.end)?;
         if t.end < t.start {
             return Err(FieldError::new(
                 "texture.end",
@@ -344,24 +321,18 @@ pub fn validate(d: &Design) -> Check {
 }
 
 fn wave(f: &str, w: &Wave) -> Check {
-    in_range(
-        &format!("{f}.period"),
-        w.period,
-        1e-3,
-        1e6,
-        "samples or layers per period",
-    )?;
-    in_range(&format!("{f}.amplitude"), w.amplitude, -100.0, 100.0, "mm")?;
-    Ok(())
+    fields::check_as("wave.period", &format!("{f}.period"), w.period)?;
+    fields::check_as("wave.amplitude", &format!("{f}.amplitude"), w.amplitude)
 }
 
 fn contour(f: &str, c: &ContourSpec) -> Check {
     let fld = |name: &str| format!("{f}.{name}");
+    let size = |name: &str, v: f64| fields::check_as(&format!("contour.{name}"), &fld(name), v);
     match c {
-        ContourSpec::Circle { radius } => positive(&fld("radius"), *radius, "mm"),
+        ContourSpec::Circle { radius } => size("radius", *radius),
         ContourSpec::Ellipse { rx, ry } => {
-            positive(&fld("rx"), *rx, "mm")?;
-            positive(&fld("ry"), *ry, "mm")
+            size("rx", *rx)?;
+            size("ry", *ry)
         }
         ContourSpec::Polygon {
             sides,
@@ -369,7 +340,7 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             corner_radius,
         } => {
             count_in(fld("sides"), *sides, 3, 1000)?;
-            positive(&fld("radius"), *radius, "mm")?;
+            size("radius", *radius)?;
             let inradius = radius * (std::f64::consts::PI / *sides as f64).cos();
             in_range(
                 &fld("corner_radius"),
@@ -385,8 +356,8 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             inner_radius,
         } => {
             count_in(fld("points"), *points, 2, 1000)?;
-            positive(&fld("outer_radius"), *outer_radius, "mm")?;
-            positive(&fld("inner_radius"), *inner_radius, "mm")?;
+            size("outer_radius", *outer_radius)?;
+            size("inner_radius", *inner_radius)?;
             if inner_radius >= outer_radius {
                 return Err(FieldError::new(
                     fld("inner_radius"),
@@ -400,7 +371,7 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
             amplitude,
             petals,
         } => {
-            positive(&fld("radius"), *radius, "mm")?;
+            size("radius", *radius)?;
             finite(&fld("amplitude"), *amplitude)?;
             if amplitude.abs() >= *radius {
                 return Err(FieldError::new(

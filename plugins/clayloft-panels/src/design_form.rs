@@ -7,7 +7,7 @@ use clayloft_core::design::{
 };
 use clayloft_model::handles::HandleRole;
 
-use crate::widgets::{count, explain, field, number, point_list};
+use crate::widgets::{count, explain, field, field_as, number, point_list};
 
 pub fn design_form(ui: &mut egui::Ui, d: &mut Design, selected: Option<HandleRole>) {
     ui.horizontal(|ui| {
@@ -195,17 +195,10 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
             }
         });
     match spec {
-        ContourSpec::Circle { radius } => number(
-            ui,
-            "Radius",
-            radius,
-            "mm",
-            1.0..=1000.0,
-            "Distance from the centre to the curve.",
-        ),
+        ContourSpec::Circle { radius } => field_as(ui, "contour.radius", radius, None),
         ContourSpec::Ellipse { rx, ry } => {
-            number(ui, "Radius x", rx, "mm", 1.0..=1000.0, "Semi-axis along x.");
-            number(ui, "Radius y", ry, "mm", 1.0..=1000.0, "Semi-axis along y.");
+            field_as(ui, "contour.rx", rx, None);
+            field_as(ui, "contour.ry", ry, None);
         }
         ContourSpec::Polygon {
             sides,
@@ -213,14 +206,7 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
             corner_radius,
         } => {
             count(ui, "Sides", sides, 3..=64, "Number of straight sides.");
-            number(
-                ui,
-                "Radius",
-                radius,
-                "mm",
-                1.0..=1000.0,
-                "Centre to corner.",
-            );
+            field_as(ui, "contour.radius", radius, None);
             number(
                 ui,
                 "Corner radius",
@@ -236,36 +222,15 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
             inner_radius,
         } => {
             count(ui, "Points", points, 2..=64, "Number of tips.");
-            number(
-                ui,
-                "Outer radius",
-                outer_radius,
-                "mm",
-                1.0..=1000.0,
-                "Centre to a tip.",
-            );
-            number(
-                ui,
-                "Inner radius",
-                inner_radius,
-                "mm",
-                1.0..=1000.0,
-                "Centre to a notch.",
-            );
+            field_as(ui, "contour.outer_radius", outer_radius, None);
+            field_as(ui, "contour.inner_radius", inner_radius, None);
         }
         ContourSpec::Rose {
             radius,
             amplitude,
             petals,
         } => {
-            number(
-                ui,
-                "Radius",
-                radius,
-                "mm",
-                1.0..=1000.0,
-                "Mean radius r₀ of r(θ) = r₀ + a·cos(kθ).",
-            );
+            field_as(ui, "contour.radius", radius, None);
             number(
                 ui,
                 "Amplitude",
@@ -500,22 +465,8 @@ fn wave(ui: &mut egui::Ui, id: &str, w: &mut Option<Wave>, period_unit: &str) {
                 ui.selectable_value(&mut w.wave, WaveKind::Triangle, "triangle");
                 ui.selectable_value(&mut w.wave, WaveKind::Square, "square");
             });
-        number(
-            ui,
-            "Period",
-            &mut w.period,
-            period_unit,
-            0.1..=10_000.0,
-            "Length of one wave.",
-        );
-        number(
-            ui,
-            "Amplitude",
-            &mut w.amplitude,
-            "mm",
-            0.0..=50.0,
-            "How far the surface moves along its normal.",
-        );
+        field_as(ui, "wave.period", &mut w.period, Some(period_unit));
+        field_as(ui, "wave.amplitude", &mut w.amplitude, None);
     }
 }
 
@@ -548,30 +499,9 @@ fn texture(ui: &mut egui::Ui, t: &mut Option<Texture>) {
         });
     wave(ui, "x", &mut t.x, "samples");
     wave(ui, "y", &mut t.y, "layers");
-    number(
-        ui,
-        "Phase drift",
-        &mut t.phase_drift,
-        "samples/layer",
-        -1000.0..=1000.0,
-        "Shift of the x wave per layer: twists the texture.",
-    );
-    number(
-        ui,
-        "Start",
-        &mut t.start,
-        "",
-        0.0..=1.0,
-        "Height fraction where the texture begins.",
-    );
-    number(
-        ui,
-        "End",
-        &mut t.end,
-        "",
-        0.0..=1.0,
-        "Height fraction where it ends.",
-    );
+    field(ui, "texture.phase_drift", &mut t.phase_drift);
+    field(ui, "texture.start", &mut t.start);
+    field(ui, "texture.end", &mut t.end);
 }
 
 /// Picks one of the shipped printer profiles: its settings replace the printer's (as a slicer

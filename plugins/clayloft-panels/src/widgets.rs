@@ -36,6 +36,13 @@ pub fn field(ui: &mut egui::Ui, path: &str, v: &mut f64) {
     number(ui, m.label, v, m.unit, m.form_range(), m.help);
 }
 
+/// A number whose meaning is a shared entry of [`clayloft_core::fields`] (`contour.radius`,
+/// `wave.amplitude`), with the unit given where it depends on the context.
+pub fn field_as(ui: &mut egui::Ui, entry: &str, v: &mut f64, unit: Option<&str>) {
+    let m = clayloft_core::fields::meta(entry);
+    number(ui, m.label, v, unit.unwrap_or(m.unit), m.form_range(), m.help);
+}
+
 /// A whole number.
 pub fn count(
     ui: &mut egui::Ui,
