@@ -57,6 +57,7 @@ fn gcode_writing(c: &mut Criterion) {
             center: DVec2::new(90.0, 95.0),
             findings: Vec::new(),
             metrics: Default::default(),
+            point_leans_deg: Vec::new(),
         }),
         toolpath: std::sync::Arc::new(Toolpath {
             points,

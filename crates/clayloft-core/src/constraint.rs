@@ -73,26 +73,24 @@ fn lean_deg(p: glam::DVec3, q: glam::DVec3, n: DVec2) -> f64 {
 /// Lean from vertical of every point, section-major (`k·n + i`), degrees; section 0 (on the bed)
 /// leans 0. The preview colours the wall by these.
 pub fn point_leans_deg(sections: &[Section]) -> Vec<f32> {
-    let mut out = Vec::with_capacity(sections.iter().map(|s| s.points.len()).sum());
-    if let Some(first) = sections.first() {
-        out.resize(first.points.len(), 0.0);
-    }
-    for k in 1..sections.len() {
-        let prev = &sections[k - 1];
-        let normals = prev.normals();
-        for (i, p) in sections[k].points.iter().enumerate() {
-            out.push(lean_deg(*p, prev.points[i], normals[i]) as f32);
-        }
-    }
-    out
+    measure_with_leans(sections).1
 }
 
 /// Largest lean, z ranges and layer heights of a surface.
 pub fn measure(sections: &[Section]) -> SurfaceMetrics {
+    measure_with_leans(sections).0
+}
+
+/// [`measure`] and [`point_leans_deg`] in one pass (the surface keeps both).
+pub fn measure_with_leans(sections: &[Section]) -> (SurfaceMetrics, Vec<f32>) {
     let mut m = SurfaceMetrics {
         min_layer_height: f64::INFINITY,
         ..Default::default()
     };
+    let mut leans = Vec::with_capacity(sections.iter().map(|s| s.points.len()).sum());
+    if let Some(first) = sections.first() {
+        leans.resize(first.points.len(), 0.0);
+    }
     for (k, s) in sections.iter().enumerate() {
         let (lo, hi) = s.z_range();
         if k > 0 {
@@ -104,14 +102,16 @@ pub fn measure(sections: &[Section]) -> SurfaceMetrics {
                 let dz = p.z - q.z;
                 m.min_layer_height = m.min_layer_height.min(dz);
                 m.max_layer_height = m.max_layer_height.max(dz);
-                m.max_overhang_deg = m.max_overhang_deg.max(lean_deg(*p, q, normals[i]));
+                let lean = lean_deg(*p, q, normals[i]);
+                m.max_overhang_deg = m.max_overhang_deg.max(lean);
+                leans.push(lean as f32);
             }
         }
     }
     if !m.min_layer_height.is_finite() {
         m.min_layer_height = 0.0;
     }
-    m
+    (m, leans)
 }
 
 #[cfg(test)]

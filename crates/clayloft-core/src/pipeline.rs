@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use glam::DVec2;
 
-use crate::constraint::{SurfaceMetrics, clamp_overhang, measure};
+use crate::constraint::{SurfaceMetrics, clamp_overhang, measure_with_leans};
 use crate::design::Design;
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind, group_events};
@@ -28,6 +28,9 @@ pub struct Surface {
     pub center: DVec2,
     pub findings: Vec<Finding>,
     pub metrics: SurfaceMetrics,
+    /// Lean from vertical of every point, section-major (`k·n + i`), degrees (the view colours
+    /// the wall by it).
+    pub point_leans_deg: Vec<f32>,
 }
 
 /// A design turned into a printable job. Shared, not copied: the app's view, the replay, the
@@ -116,7 +119,7 @@ pub fn finish_surface(
             |mm| format!("textured wall clamped by up to {mm:.2} mm at the overhang limit"),
         ));
     }
-    let metrics = measure(&sections);
+    let (metrics, point_leans_deg) = measure_with_leans(&sections);
     let surface = Surface {
         sections,
         layers: model.layers,
@@ -124,6 +127,7 @@ pub fn finish_surface(
         center,
         findings,
         metrics,
+        point_leans_deg,
     };
     check_fits_machine(design, &surface)?;
     Ok(surface)

@@ -4,7 +4,6 @@
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
-use clayloft_core::constraint::point_leans_deg;
 use clayloft_core::pipeline::Surface;
 
 use crate::coords::to_world;
@@ -50,7 +49,15 @@ pub fn wall_buffers(surface: &Surface, limit_deg: f64) -> WallBuffers {
     if rows < 2 || n < 3 {
         return WallBuffers::default();
     }
-    let leans = point_leans_deg(sections);
+    // The surface's own leans (measured once by the core); a surface put together by hand may
+    // lack them.
+    let computed;
+    let leans = if surface.point_leans_deg.len() == rows * n {
+        &surface.point_leans_deg
+    } else {
+        computed = clayloft_core::constraint::point_leans_deg(sections);
+        &computed
+    };
     let positions: Vec<[f32; 3]> = sections
         .iter()
         .flat_map(|s| s.points.iter().map(|p| to_world(*p).to_array()))
