@@ -256,6 +256,25 @@ mod tests {
             "rebuilt while idle"
         );
         assert_eq!(app.world().resource::<Changes>().0, 0, "changes while idle");
+        // The camera cannot zoom into the wall, and "frame the vessel" brings it back.
+        let frame = {
+            let mut q = app.world_mut().query::<&clayloft_model::VesselSurface>();
+            let surface = q.single(app.world()).unwrap().0.clone();
+            let h = app.world().resource::<DesignDoc>().design.shape.height;
+            clayloft_view::camera_frame(&surface, h)
+        };
+        let mut q = app.world_mut().query::<&mut bevy_panorbit_camera::PanOrbitCamera>();
+        {
+            let mut cam = q.single_mut(app.world_mut()).unwrap();
+            assert_eq!(cam.zoom_lower_limit, frame.min_radius);
+            cam.target_radius = frame.min_radius * 3.0;
+        }
+        app.world_mut()
+            .resource_mut::<Messages<clayloft_view::FrameVessel>>()
+            .write(clayloft_view::FrameVessel);
+        app.update();
+        let cam = q.single(app.world()).unwrap();
+        assert_eq!(cam.target_radius, frame.radius);
         // One edit: exactly one recompute and one wall rebuild.
         app.world_mut()
             .resource_mut::<DesignDoc>()

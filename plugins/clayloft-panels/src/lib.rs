@@ -15,7 +15,7 @@ use clayloft_edit::{HistoryCommand, PanelInUse, Selection};
 use clayloft_files::{FileCommand, FileStatus};
 use clayloft_model::*;
 use clayloft_replay::{Replay, ReplayPath};
-use clayloft_view::{ViewSettings, WallStats};
+use clayloft_view::{FrameVessel, ViewSettings, WallStats};
 
 /// Paths typed in the file bar.
 #[derive(Resource, Debug, Clone, Default)]
@@ -53,7 +53,7 @@ fn draw_panels(
     vessel: Query<&VesselSurface>,
     toolpath: Query<&ToolpathPath>,
     selection: Res<Selection>,
-    mut panel: ResMut<PanelInUse>,
+    (mut panel, mut frame): (ResMut<PanelInUse>, MessageWriter<FrameVessel>),
     mut path_figures: Local<(usize, f64, f64)>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
@@ -136,6 +136,13 @@ fn draw_panels(
             ui.checkbox(&mut shown.show_control_lines, "control lines");
             ui.checkbox(&mut shown.show_build_volume, "build volume");
             settings.set_if_neq(shown);
+            if ui
+                .button("Frame vessel")
+                .on_hover_text("Point the camera at the whole vessel (F)")
+                .clicked()
+            {
+                frame.write(FrameVessel);
+            }
         });
     });
 

@@ -60,7 +60,8 @@ pub struct ViewPlugin;
 
 impl Plugin for ViewPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<ViewSettings>()
+        app.add_message::<FrameVessel>()
+            .init_resource::<ViewSettings>()
             .init_resource::<WallStats>()
             .init_resource::<ViewRebuilds>()
             .insert_resource(ClearColor(Color::srgb(0.13, 0.14, 0.16)))
@@ -193,39 +194,82 @@ pub fn wall_mesh_bundle(
     )
 }
 
-/// Points the camera at the vessel the first time there is one.
+/// Asks the view to point the camera at the whole vessel (the panels' button, the F key).
+#[derive(Message, Debug, Clone, Copy, Default)]
+pub struct FrameVessel;
+
+/// Where the camera looks at a vessel from, and how near and far it may zoom (world units, mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraFrame {
+    pub focus: Vec3,
+    pub radius: f32,
+    /// Nearest the camera may come to the focus: outside the sphere around the focus that holds
+    /// the whole vessel, so no zoom puts it inside the wall.
+    pub min_radius: f32,
+    pub max_radius: f32,
+}
+
+/// The camera frame of a surface: focus at 40 % of the height over the centre, the whole vessel
+/// in view, zoom kept outside the vessel's bounding sphere and within ten times it.
+pub fn camera_frame(surface: &clayloft_core::pipeline::Surface, height: f64) -> CameraFrame {
+    let focus = surface.center.extend(height * 0.4);
+    let (mut lo, mut hi) = (
+        bevy::math::DVec2::splat(f64::MAX),
+        bevy::math::DVec2::splat(f64::MIN),
+    );
+    let mut reach: f64 = 1.0;
+    for q in surface.sections.iter().flat_map(|s| &s.points) {
+        lo = lo.min(q.truncate());
+        hi = hi.max(q.truncate());
+        reach = reach.max(q.distance(focus));
+    }
+    let extent = (hi - lo).max_element().max(height).max(1.0);
+    let min_radius = (reach * 1.1 + 10.0) as f32;
+    let radius = ((extent * 2.4).max(200.0) as f32).max(min_radius * 1.5);
+    CameraFrame {
+        focus: to_world(focus),
+        radius,
+        min_radius,
+        max_radius: (radius * 10.0).max(min_radius * 10.0),
+    }
+}
+
+/// Frames the camera on the vessel the first time there is one and whenever asked (the F key
+/// outside text fields, the panels' button); the zoom limits follow every new surface.
 fn frame_camera_on_first_surface(
-    vessel: Query<&VesselSurface, Added<VesselSurface>>,
+    vessel: Query<Ref<VesselSurface>>,
     doc: Option<Res<DesignDoc>>,
     mut camera: Query<&mut PanOrbitCamera>,
+    mut asked: MessageReader<FrameVessel>,
+    keys: Option<Res<ButtonInput<KeyCode>>>,
+    panel: Option<Res<clayloft_edit::PanelInUse>>,
     mut done: Local<bool>,
 ) {
     let (Some(surface), Some(doc)) = (vessel.iter().next(), doc) else {
+        asked.clear();
         return;
     };
-    if *done {
+    let typing = panel.is_some_and(|p| p.typing);
+    let key = !typing && keys.is_some_and(|k| k.just_pressed(KeyCode::KeyF));
+    let asked = asked.read().count() > 0 || key;
+    if !asked && *done && !surface.is_changed() {
         return;
     }
-    *done = true;
-    let h = doc.design.shape.height;
-    let focus = to_world(surface.0.center.extend(h * 0.4));
+    let frame = camera_frame(&surface.0, doc.design.shape.height);
     for mut cam in &mut camera {
-        cam.target_focus = focus;
-        cam.focus = focus;
-        let (mut lo, mut hi) = (
-            bevy::math::DVec2::splat(f64::MAX),
-            bevy::math::DVec2::splat(f64::MIN),
-        );
-        for q in surface.0.sections.iter().flat_map(|s| &s.points) {
-            lo = lo.min(q.truncate());
-            hi = hi.max(q.truncate());
+        cam.zoom_lower_limit = frame.min_radius;
+        cam.zoom_upper_limit = Some(frame.max_radius);
+        if asked || !*done {
+            cam.target_focus = frame.focus;
+            cam.focus = frame.focus;
+            cam.target_radius = frame.radius;
+            cam.radius = Some(frame.radius);
+        } else {
+            cam.target_radius = cam.target_radius.clamp(frame.min_radius, frame.max_radius);
         }
-        let extent = (hi - lo).max_element().max(h);
-        let r = (extent * 2.4).max(200.0) as f32;
-        cam.target_radius = r;
-        cam.radius = Some(r);
         cam.force_update = true;
     }
+    *done = true;
 }
 
 fn rebuild_wall_mesh(
@@ -396,5 +440,28 @@ fn draw_control_lines(
             LineKind::Horizontal => Color::srgb(0.95, 0.4, 0.9),
         };
         gizmos.linestrip(curve.0.iter().map(|p| to_world(*p)), color);
+    }
+}
+
+#[cfg(test)]
+mod camera_tests {
+    use super::*;
+
+    /// The nearest zoom keeps the camera outside every wall point (seen from the focus), and the
+    /// framed distance lies between the limits.
+    #[test]
+    fn zoom_stops_outside_the_vessel() {
+        for name in ["petal-vase.toml", "flared-bowl.toml", "tilted-rim.toml"] {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../assets/designs")
+                .join(name);
+            let d = clayloft_core::load_design(&path).unwrap().design;
+            let job = clayloft_core::run(&d).unwrap();
+            let f = camera_frame(&job.surface, d.shape.height);
+            for q in job.surface.sections.iter().flat_map(|s| &s.points) {
+                assert!(to_world(*q).distance(f.focus) < f.min_radius, "{name}");
+            }
+            assert!(f.min_radius < f.radius && f.radius < f.max_radius, "{name}: {f:?}");
+        }
     }
 }
