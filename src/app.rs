@@ -113,8 +113,12 @@ fn log_frames(
     {
         counts.2 += 1;
         if counts.2 == 1 {
-            let events = ctx.input(|i| format!("{:?} pointer {:?}", i.raw.events, i.pointer.latest_pos()));
-            info!("egui repaint causes: {:?}; input: {events}", ctx.repaint_causes());
+            let events =
+                ctx.input(|i| format!("{:?} pointer {:?}", i.raw.events, i.pointer.latest_pos()));
+            info!(
+                "egui repaint causes: {:?}; input: {events}",
+                ctx.repaint_causes()
+            );
         }
     }
     let now = time.elapsed_secs_f64();
@@ -207,8 +211,8 @@ mod tests {
     /// lines, and the design, the engine and the view settings are never marked changed.
     #[test]
     fn idle_frames_rebuild_nothing() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("assets/designs/petal-vase.toml");
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs/petal-vase.toml");
         let design = clayloft_core::load_design(&path).unwrap().design;
         let mut app = headless(design);
         #[derive(Resource, Default, Debug)]
@@ -237,7 +241,10 @@ mod tests {
         for _ in 0..5 {
             app.update();
         }
-        let passes = app.world().resource::<clayloft_model::RecomputeLog>().passes;
+        let passes = app
+            .world()
+            .resource::<clayloft_model::RecomputeLog>()
+            .passes;
         let rebuilds = *app.world().resource::<clayloft_view::ViewRebuilds>();
         assert_eq!(passes, 1);
         assert_eq!(rebuilds.wall_mesh, 1);
@@ -246,7 +253,9 @@ mod tests {
             app.update();
         }
         assert_eq!(
-            app.world().resource::<clayloft_model::RecomputeLog>().passes,
+            app.world()
+                .resource::<clayloft_model::RecomputeLog>()
+                .passes,
             passes,
             "recomputed while idle"
         );
@@ -263,7 +272,9 @@ mod tests {
             let h = app.world().resource::<DesignDoc>().design.shape.height;
             clayloft_view::camera_frame(&surface, h)
         };
-        let mut q = app.world_mut().query::<&mut bevy_panorbit_camera::PanOrbitCamera>();
+        let mut q = app
+            .world_mut()
+            .query::<&mut bevy_panorbit_camera::PanOrbitCamera>();
         {
             let mut cam = q.single_mut(app.world_mut()).unwrap();
             assert_eq!(cam.zoom_lower_limit, frame.min_radius);
@@ -285,7 +296,9 @@ mod tests {
             app.update();
         }
         assert_eq!(
-            app.world().resource::<clayloft_model::RecomputeLog>().passes,
+            app.world()
+                .resource::<clayloft_model::RecomputeLog>()
+                .passes,
             passes + 1
         );
     }

@@ -95,6 +95,7 @@ const fn field(
 }
 
 /// Every plain number of a design, in form order.
+#[rustfmt::skip]
 pub const FIELDS: &[FieldMeta] = &[
     field("shape.height", "Height", "mm", 0.0, MAX_LENGTH, true,
         "Height of the vessel from the bed to the rim."),

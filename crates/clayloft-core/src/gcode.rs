@@ -290,10 +290,7 @@ fn write_program_indexed(
             })
         });
         let summary = summarize(design, job);
-        let thumbnails = thumbnails.map(|h| {
-            h.join()
-                .unwrap_or_else(|e: Box<dyn std::any::Any + Send>| std::panic::resume_unwind(e))
-        });
+        let thumbnails = thumbnails.map(|h| crate::parallel::join(h));
         (summary, thumbnails)
     });
     let values = template_values(design, job, &summary);
@@ -546,9 +543,7 @@ impl<'a> BodyWriter<'a> {
         if n < 2 {
             return Ok(());
         }
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |t| t.get())
-            .clamp(1, 2);
+        let threads = crate::parallel::cores().clamp(1, 2);
         let mut state = BodyState {
             t_done: 0.0,
             e_total: 0.0,
@@ -583,11 +578,7 @@ impl<'a> BodyWriter<'a> {
                         .collect();
                     handles
                         .into_iter()
-                        .map(|h| {
-                            h.join().unwrap_or_else(
-                                |e: Box<dyn std::any::Any + Send>| std::panic::resume_unwind(e),
-                            )
-                        })
+                        .map(|h| crate::parallel::join(h))
                         .collect()
                 })
             };
@@ -666,8 +657,9 @@ impl<'a> BodyWriter<'a> {
                     let percent = self.percent(st.t_done);
                     if percent != st.last_percent {
                         mark(&mut lines, 1, i - 1);
-                        let left_min =
-                            ((self.nominal - st.t_done) * self.scale / 60.0).ceil().max(0.0);
+                        let left_min = ((self.nominal - st.t_done) * self.scale / 60.0)
+                            .ceil()
+                            .max(0.0);
                         buf.extend_from_slice(
                             format!("M73 P{percent} R{left_min:.0}\n").as_bytes(),
                         );
@@ -794,7 +786,10 @@ mod tests {
                 let x: f64 = words[0].parse().unwrap();
                 let y: f64 = words[1].trim_start_matches('Y').parse().unwrap();
                 let q = job.toolpath.points[point as usize].pos;
-                assert!((q.x - ox - x).abs() < 1e-3 && (q.y - oy - y).abs() < 1e-3, "{line}");
+                assert!(
+                    (q.x - ox - x).abs() < 1e-3 && (q.y - oy - y).abs() < 1e-3,
+                    "{line}"
+                );
                 moves += 1;
             }
             assert_eq!(moves, job.toolpath.points.len() - 1);

@@ -33,6 +33,7 @@ pub mod load;
 pub mod loft;
 pub mod motion;
 pub mod outline;
+pub mod parallel;
 pub mod pipeline;
 pub mod profile;
 pub mod report;

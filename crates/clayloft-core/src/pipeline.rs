@@ -11,9 +11,9 @@ use crate::design::Design;
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind, group_events};
 use crate::section::Section;
+use crate::session::Session;
 use crate::shape::{LIMIT_MARGIN, ShapeModel};
 use crate::texture::{apply_displacements, apply_texture};
-use crate::session::Session;
 use crate::toolpath::Toolpath;
 use crate::validate::FieldError;
 

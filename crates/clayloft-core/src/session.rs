@@ -26,9 +26,7 @@ use std::sync::Arc;
 use glam::DVec2;
 
 use crate::control::VerticalProfile;
-use crate::design::{
-    BedShape, ContourSpec, Design, HorizontalLine, Origin, Texture, VerticalLine,
-};
+use crate::design::{BedShape, ContourSpec, Design, HorizontalLine, Origin, Texture, VerticalLine};
 use crate::loft::{LoftInput, SampledContour, sample_contour};
 use crate::pipeline::{PrintJob, Surface, finish_surface};
 use crate::report::Finding;
@@ -329,7 +327,11 @@ impl Session {
                 sections: count,
             };
             self.texture.refresh(key, || {
-                Ok(crate::texture::displacements(tex, model.loft.samples(), count))
+                Ok(crate::texture::displacements(
+                    tex,
+                    model.loft.samples(),
+                    count,
+                ))
             })?;
         }
         let p = &design.printer;
@@ -434,9 +436,7 @@ const PARALLEL_POINTS: usize = 20_000;
 /// Shapes the sections `ks` of `model`, split over the machine's cores when there is enough work.
 fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<Section> {
     let work = ks.len() * model.loft.samples();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(ks.len());
+    let threads = crate::parallel::cores().min(ks.len());
     if threads < 2 || work < PARALLEL_POINTS {
         return ks.iter().map(|&k| model.section(k)).collect();
     }
@@ -450,10 +450,7 @@ fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<Section> {
             .collect();
         handles
             .into_iter()
-            .flat_map(|h| {
-                h.join()
-                    .unwrap_or_else(|e: Box<dyn std::any::Any + Send>| std::panic::resume_unwind(e))
-            })
+            .flat_map(|h| crate::parallel::join(h))
             .collect::<Vec<Section>>()
     })
 }
@@ -498,7 +495,11 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
     fn edit(d: &mut Design, which: u8, amount: f64) {
         let a = amount; // in [0, 1)
         match which % 22 {
-            0 => d.shape.lower = ContourSpec::Circle { radius: 20.0 + 10.0 * a },
+            0 => {
+                d.shape.lower = ContourSpec::Circle {
+                    radius: 20.0 + 10.0 * a,
+                }
+            }
             1 => {
                 d.shape.upper = ContourSpec::Star {
                     points: 5,
@@ -565,7 +566,10 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
             (Ok(_), Ok(b)) => {
                 let job = session.job().unwrap();
                 assert_eq!(*job.surface, *b.surface, "surface differs from a batch run");
-                assert_eq!(*job.toolpath, *b.toolpath, "toolpath differs from a batch run");
+                assert_eq!(
+                    *job.toolpath, *b.toolpath,
+                    "toolpath differs from a batch run"
+                );
                 assert!(session.is_current());
             }
             (Err(e), Err(b)) => {

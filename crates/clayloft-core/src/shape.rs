@@ -8,9 +8,9 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::control::angle_difference;
 use crate::control::{HorizontalProfile, VerticalProfile};
 use crate::design::Design;
-use crate::control::angle_difference;
 use crate::geometry::{outward_normal_at, outward_normals};
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind};
@@ -469,7 +469,11 @@ mod wall_tests {
             for i in (0..m.loft.samples()).step_by(7) {
                 assert!(s.points[i].distance(at.points[i]) < 1e-9, "k {k} i {i}");
                 let w = m.wall_point(i, k as f64 / m.layers as f64);
-                assert!(s.points[i].distance(w) < 1e-9, "k {k} i {i}: {w} vs {}", s.points[i]);
+                assert!(
+                    s.points[i].distance(w) < 1e-9,
+                    "k {k} i {i}: {w} vs {}",
+                    s.points[i]
+                );
             }
         }
         // The vertical line's curve is its column of the sections, exactly.
@@ -495,6 +499,9 @@ mod wall_tests {
         // Near its own angle the weight is about 1: the direction is the normal, not the radius.
         assert!((dir.length() - 1.0).abs() < 0.01, "{}", dir.length());
         let radial = (on_wall.truncate() - m.loft.center).normalize();
-        assert!(dir.normalize().dot(radial) < 0.9999, "the star's normal is not radial here");
+        assert!(
+            dir.normalize().dot(radial) < 0.9999,
+            "the star's normal is not radial here"
+        );
     }
 }

@@ -60,19 +60,19 @@ pub fn picking_setup(app: &mut App) {
 
 pub(crate) fn plugin(app: &mut App) {
     app.init_resource::<Selection>()
-    .init_resource::<ActiveDrag>()
-    .add_systems(Startup, make_handle_look)
-    .add_systems(
-        Update,
-        (
-            mark_picking_camera,
-            show_new_handles,
-            place_handles,
-            colour_selected_handle,
-            gate_camera,
-        )
-            .in_set(ModelSystems::View),
-    );
+        .init_resource::<ActiveDrag>()
+        .add_systems(Startup, make_handle_look)
+        .add_systems(
+            Update,
+            (
+                mark_picking_camera,
+                show_new_handles,
+                place_handles,
+                colour_selected_handle,
+                gate_camera,
+            )
+                .in_set(ModelSystems::View),
+        );
 }
 
 fn make_handle_look(

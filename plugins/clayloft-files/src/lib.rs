@@ -225,19 +225,27 @@ fn poll_exports(
     if exports.running.is_empty() {
         return;
     }
-    exports.running.retain_mut(|(path, rx)| match rx.get_mut().map_or(Err(TryRecvError::Disconnected), |r| r.try_recv()) {
-        Ok(Ok(m)) => {
-            status.ok(m);
-            false
-        }
-        Ok(Err(e)) => {
-            status.err(e);
-            false
-        }
-        Err(TryRecvError::Empty) => true,
-        Err(TryRecvError::Disconnected) => {
-            status.err(format!("{}: the export stopped unexpectedly", path.display()));
-            false
+    exports.running.retain_mut(|(path, rx)| {
+        match rx
+            .get_mut()
+            .map_or(Err(TryRecvError::Disconnected), |r| r.try_recv())
+        {
+            Ok(Ok(m)) => {
+                status.ok(m);
+                false
+            }
+            Ok(Err(e)) => {
+                status.err(e);
+                false
+            }
+            Err(TryRecvError::Empty) => true,
+            Err(TryRecvError::Disconnected) => {
+                status.err(format!(
+                    "{}: the export stopped unexpectedly",
+                    path.display()
+                ));
+                false
+            }
         }
     });
     if !exports.running.is_empty()
@@ -286,11 +294,25 @@ fn run_file_commands(
             }
             FileCommand::ExportGcode(path) => {
                 let job = current_job(&engine, &doc.design, path);
-                start_export(&mut exports, &mut status, path, job, &doc.design, export_gcode);
+                start_export(
+                    &mut exports,
+                    &mut status,
+                    path,
+                    job,
+                    &doc.design,
+                    export_gcode,
+                );
             }
             FileCommand::ExportStl(path) => {
                 let job = current_job(&engine, &doc.design, path);
-                start_export(&mut exports, &mut status, path, job, &doc.design, export_stl);
+                start_export(
+                    &mut exports,
+                    &mut status,
+                    path,
+                    job,
+                    &doc.design,
+                    export_stl,
+                );
             }
         }
     }
@@ -481,7 +503,11 @@ mod tests {
             std::thread::sleep(Duration::from_millis(10));
             app.update();
         }
-        assert_eq!(app.world().resource::<Exports>().pending(), 0, "export still running");
+        assert_eq!(
+            app.world().resource::<Exports>().pending(),
+            0,
+            "export still running"
+        );
     }
 
     /// An invalid design is not exported: the message says why, and no file appears.

@@ -19,7 +19,10 @@ pub struct Engine(pub Session);
 impl Engine {
     /// The session's job for exactly this design (what exports and the printer use: nothing is
     /// recomputed), or why there is none in a sentence.
-    pub fn current_job(&self, design: &clayloft_core::Design) -> Result<clayloft_core::PrintJob, String> {
+    pub fn current_job(
+        &self,
+        design: &clayloft_core::Design,
+    ) -> Result<clayloft_core::PrintJob, String> {
         let session = &self.0;
         if let Some(e) = session.error() {
             return Err(format!("the design has an error: {e}"));
@@ -158,9 +161,13 @@ pub fn derive_control_lines(
     };
     let curve = |line: ControlLine| -> Vec<DVec3> {
         match line.kind {
-            LineKind::Vertical => design.control.vertical.get(line.index).map_or_else(Vec::new, |v| {
-                model.vertical_line_curve(line.index, v.angle.unwrap_or(0.0))
-            }),
+            LineKind::Vertical => design
+                .control
+                .vertical
+                .get(line.index)
+                .map_or_else(Vec::new, |v| {
+                    model.vertical_line_curve(line.index, v.angle.unwrap_or(0.0))
+                }),
             LineKind::Horizontal => design
                 .control
                 .horizontal

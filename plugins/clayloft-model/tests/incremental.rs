@@ -280,7 +280,10 @@ fn control_lines_and_their_handles_lie_on_the_wall_of_every_shipped_design() {
                             .points,
                     ),
                 };
-                assert!(d < 0.01, "{name}: {line:?} vertex {k} is {d:.4} mm off the wall");
+                assert!(
+                    d < 0.01,
+                    "{name}: {line:?} vertex {k} is {d:.4} mm off the wall"
+                );
                 checked += 1;
             }
         }

@@ -40,7 +40,14 @@ pub fn field(ui: &mut egui::Ui, path: &str, v: &mut f64) {
 /// `wave.amplitude`), with the unit given where it depends on the context.
 pub fn field_as(ui: &mut egui::Ui, entry: &str, v: &mut f64, unit: Option<&str>) {
     let m = clayloft_core::fields::meta(entry);
-    number(ui, m.label, v, unit.unwrap_or(m.unit), m.form_range(), m.help);
+    number(
+        ui,
+        m.label,
+        v,
+        unit.unwrap_or(m.unit),
+        m.form_range(),
+        m.help,
+    );
 }
 
 /// A whole number.

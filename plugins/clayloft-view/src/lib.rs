@@ -461,7 +461,10 @@ mod camera_tests {
             for q in job.surface.sections.iter().flat_map(|s| &s.points) {
                 assert!(to_world(*q).distance(f.focus) < f.min_radius, "{name}");
             }
-            assert!(f.min_radius < f.radius && f.radius < f.max_radius, "{name}: {f:?}");
+            assert!(
+                f.min_radius < f.radius && f.radius < f.max_radius,
+                "{name}: {f:?}"
+            );
         }
     }
 }

@@ -358,9 +358,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
     /// Every point, split over the machine's cores; each part gets its share of the budget.
     fn all(&self, budget: usize) -> Vec<Below> {
         let n = self.v.len();
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |t| t.get())
-            .clamp(1, 8);
+        let threads = crate::parallel::cores().clamp(1, 8);
         if threads < 2 || n < 20_000 {
             return self.range(0..n, budget);
         }
@@ -373,11 +371,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
                 .collect();
             parts
                 .into_iter()
-                .flat_map(|h| {
-                    h.join().unwrap_or_else(|e: Box<dyn std::any::Any + Send>| {
-                        std::panic::resume_unwind(e)
-                    })
-                })
+                .flat_map(|h| crate::parallel::join(h))
                 .collect()
         })
     }
