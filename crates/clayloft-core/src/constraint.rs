@@ -81,35 +81,57 @@ pub fn measure(sections: &[Section]) -> SurfaceMetrics {
     measure_with_leans(sections).0
 }
 
-/// [`measure`] and [`point_leans_deg`] in one pass (the surface keeps both).
+/// [`measure`] and [`point_leans_deg`] in one pass (the surface keeps both); the sections are
+/// measured in parts on the machine's cores and the parts merged (maxima and minima).
 pub fn measure_with_leans(sections: &[Section]) -> (SurfaceMetrics, Vec<f32>) {
+    let parts =
+        crate::parallel::map_ranges(sections.len(), 64, |r| vec![measure_part(sections, r)]);
     let mut m = SurfaceMetrics {
         min_layer_height: f64::INFINITY,
         ..Default::default()
     };
     let mut leans = Vec::with_capacity(sections.iter().map(|s| s.points.len()).sum());
-    if let Some(first) = sections.first() {
-        leans.resize(first.points.len(), 0.0);
-    }
-    for (k, s) in sections.iter().enumerate() {
-        let (lo, hi) = s.z_range();
-        if k > 0 {
-            m.max_layer_z_range = m.max_layer_z_range.max(hi - lo);
-            let prev = &sections[k - 1];
-            let normals = prev.normals();
-            for (i, p) in s.points.iter().enumerate() {
-                let q = prev.points[i];
-                let dz = p.z - q.z;
-                m.min_layer_height = m.min_layer_height.min(dz);
-                m.max_layer_height = m.max_layer_height.max(dz);
-                let lean = lean_deg(*p, q, normals[i]);
-                m.max_overhang_deg = m.max_overhang_deg.max(lean);
-                leans.push(lean as f32);
-            }
-        }
+    for (part, part_leans) in parts {
+        m.max_overhang_deg = m.max_overhang_deg.max(part.max_overhang_deg);
+        m.max_layer_z_range = m.max_layer_z_range.max(part.max_layer_z_range);
+        m.min_layer_height = m.min_layer_height.min(part.min_layer_height);
+        m.max_layer_height = m.max_layer_height.max(part.max_layer_height);
+        leans.extend_from_slice(&part_leans);
     }
     if !m.min_layer_height.is_finite() {
         m.min_layer_height = 0.0;
+    }
+    (m, leans)
+}
+
+/// The metrics and leans of sections `range` (section 0, on the bed, leans 0 and bounds no
+/// layer).
+fn measure_part(sections: &[Section], range: std::ops::Range<usize>) -> (SurfaceMetrics, Vec<f32>) {
+    let mut m = SurfaceMetrics {
+        min_layer_height: f64::INFINITY,
+        ..Default::default()
+    };
+    let mut leans =
+        Vec::with_capacity(sections[range.clone()].iter().map(|s| s.points.len()).sum());
+    for k in range {
+        let s = &sections[k];
+        if k == 0 {
+            leans.resize(s.points.len(), 0.0);
+            continue;
+        }
+        let (lo, hi) = s.z_range();
+        m.max_layer_z_range = m.max_layer_z_range.max(hi - lo);
+        let prev = &sections[k - 1];
+        let normals = prev.normals();
+        for (i, p) in s.points.iter().enumerate() {
+            let q = prev.points[i];
+            let dz = p.z - q.z;
+            m.min_layer_height = m.min_layer_height.min(dz);
+            m.max_layer_height = m.max_layer_height.max(dz);
+            let lean = lean_deg(*p, q, normals[i]);
+            m.max_overhang_deg = m.max_overhang_deg.max(lean);
+            leans.push(lean as f32);
+        }
     }
     (m, leans)
 }

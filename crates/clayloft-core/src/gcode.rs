@@ -285,7 +285,9 @@ fn write_program_indexed(
     let (summary, thumbnails) = std::thread::scope(|scope| {
         let thumbnails = p.thumbnail.then(|| {
             scope.spawn(|| {
-                let points: Vec<DVec3> = tp.points.iter().map(|q| q.pos).collect();
+                // Thinned to what a thumbnail draws: no copy of the whole path.
+                let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
+                let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
                 crate::thumbnail::header_blocks(&points)
             })
         });

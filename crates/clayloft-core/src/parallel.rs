@@ -1,5 +1,8 @@
-//! The two helpers every stage that uses both cores shares (scoped threads from `std`; the
-//! work is split by each stage, where the split is part of its math).
+//! The helpers every stage that uses both cores shares (scoped threads from `std`; the work is
+//! split by each stage into contiguous ranges, so results come back in order and do not depend
+//! on the number of cores).
+
+use std::ops::Range;
 
 /// Threads worth starting for independent work: the machine's cores (1 if unknown).
 pub fn cores() -> usize {
@@ -11,4 +14,83 @@ pub fn join<T>(handle: std::thread::ScopedJoinHandle<'_, T>) -> T {
     handle
         .join()
         .unwrap_or_else(|e| std::panic::resume_unwind(e))
+}
+
+/// `0..len` cut into one contiguous range per core, or a single range when `len` is below
+/// `serial_below` (starting a thread costs more than small work).
+fn ranges(len: usize, serial_below: usize) -> Vec<Range<usize>> {
+    let threads = cores().min(len.max(1));
+    if threads < 2 || len < serial_below {
+        return vec![0..len];
+    }
+    let chunk = len.div_ceil(threads);
+    (0..len)
+        .step_by(chunk)
+        .map(|s| s..(s + chunk).min(len))
+        .collect()
+}
+
+/// `f` on contiguous parts of `0..len`, one per core, results concatenated in order.
+pub fn map_ranges<R: Send>(
+    len: usize,
+    serial_below: usize,
+    f: impl Fn(Range<usize>) -> Vec<R> + Sync,
+) -> Vec<R> {
+    let parts = ranges(len, serial_below);
+    if parts.len() == 1 {
+        return f(0..len);
+    }
+    let f = &f;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = parts
+            .into_iter()
+            .map(|r| scope.spawn(move || f(r)))
+            .collect();
+        handles.into_iter().flat_map(join).collect()
+    })
+}
+
+/// `f(offset, part)` on contiguous parts of `items`, one per core (`offset`: the index of the
+/// part's first item).
+pub fn for_each_part<T: Send>(
+    items: &mut [T],
+    serial_below: usize,
+    f: impl Fn(usize, &mut [T]) + Sync,
+) {
+    let parts = ranges(items.len(), serial_below);
+    if parts.len() == 1 {
+        return f(0, items);
+    }
+    let f = &f;
+    let chunk = parts[0].len();
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = items
+            .chunks_mut(chunk)
+            .enumerate()
+            .map(|(j, part)| scope.spawn(move || f(j * chunk, part)))
+            .collect();
+        handles.into_iter().for_each(join);
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parts_cover_the_range_in_order() {
+        for len in [0, 1, 2, 7, 100, 1001] {
+            for serial in [0, 10, 10_000] {
+                let all: Vec<usize> = map_ranges(len, serial, |r| r.collect());
+                assert_eq!(all, (0..len).collect::<Vec<_>>());
+                let mut v = vec![0usize; len];
+                for_each_part(&mut v, serial, |off, part| {
+                    for (j, x) in part.iter_mut().enumerate() {
+                        *x = off + j;
+                    }
+                });
+                assert_eq!(v, (0..len).collect::<Vec<_>>());
+            }
+        }
+    }
 }

@@ -435,23 +435,9 @@ const PARALLEL_POINTS: usize = 20_000;
 
 /// Shapes the sections `ks` of `model`, split over the machine's cores when there is enough work.
 fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<Section> {
-    let work = ks.len() * model.loft.samples();
-    let threads = crate::parallel::cores().min(ks.len());
-    if threads < 2 || work < PARALLEL_POINTS {
-        return ks.iter().map(|&k| model.section(k)).collect();
-    }
-    let chunk = ks.len().div_ceil(threads);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = ks
-            .chunks(chunk)
-            .map(|part| {
-                scope.spawn(move || part.iter().map(|&k| model.section(k)).collect::<Vec<_>>())
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| crate::parallel::join(h))
-            .collect::<Vec<Section>>()
+    let per_section = model.loft.samples().max(1);
+    crate::parallel::map_ranges(ks.len(), PARALLEL_POINTS / per_section, |r| {
+        ks[r].iter().map(|&k| model.section(k)).collect()
     })
 }
 

@@ -70,9 +70,23 @@ pub fn apply_texture(
 /// incremental engine keeps it while the shape is edited.
 pub fn displacements(tex: &Texture, n: usize, count: usize) -> Vec<Vec<f64>> {
     let layers = count.saturating_sub(1);
-    (0..count)
-        .map(|k| (0..n).map(|i| displacement(tex, i, k, layers)).collect())
+    // Without phase drift every textured section has the same x wave: computed once.
+    let row0: Option<Vec<f64>> =
+        (tex.phase_drift == 0.0).then(|| (0..n).map(|i| displacement(tex, i, 0, 0)).collect());
+    crate::parallel::map_ranges(count, 64, |ks| {
+        ks.map(|k| {
+            let t = k as f64 / layers.max(1) as f64;
+            if t < tex.start - 1e-12 || t > tex.end + 1e-12 {
+                return vec![0.0; n];
+            }
+            match (&row0, tex.y.is_some()) {
+                // x wave only: the same row on every section.
+                (Some(row), false) => row.clone(),
+                _ => (0..n).map(|i| displacement(tex, i, k, layers)).collect(),
+            }
+        })
         .collect()
+    })
 }
 
 /// [`apply_texture`] with the displacements given (from [`displacements`] for these sections).
@@ -83,29 +97,35 @@ pub fn apply_displacements(
     enforce: bool,
 ) -> Vec<crate::report::PointEvent> {
     let n = sections.first().map_or(0, |s| s.points.len());
-    let normals: Vec<Vec<glam::DVec2>> = sections.iter().map(|s| s.normals()).collect();
-    // Largest admissible scale per column, and the layer where it binds.
-    let mut scale = vec![(1.0_f64, 0_usize); n];
-    for k in 1..sections.len() {
-        for i in 0..n {
-            let (p, q) = (sections[k].points[i], sections[k - 1].points[i]);
-            let nb = normals[k - 1][i];
-            let b = (p.truncate() - q.truncate()).dot(nb);
-            let dd = disp[k][i] * normals[k][i].dot(nb) - disp[k - 1][i];
-            let limit = (p.z - q.z).max(0.0) * tan_limit;
-            let allowed = if dd > 1e-12 {
-                (limit - b) / dd
-            } else if dd < -1e-12 {
-                (limit + b) / -dd
-            } else {
-                1.0
-            };
-            let allowed = allowed.clamp(0.0, 1.0);
-            if allowed < scale[i].0 {
-                scale[i] = (allowed, k);
+    let normals: Vec<Vec<glam::DVec2>> = crate::parallel::map_ranges(sections.len(), 64, |r| {
+        sections[r].iter().map(|s| s.normals()).collect()
+    });
+    // Largest admissible scale per column, and the layer where it binds (columns in parts).
+    let scale: Vec<(f64, usize)> = crate::parallel::map_ranges(n, 128, |cols| {
+        let mut scale = vec![(1.0_f64, 0_usize); cols.len()];
+        for k in 1..sections.len() {
+            let (above, below) = (&sections[k].points, &sections[k - 1].points);
+            for (c, i) in cols.clone().enumerate() {
+                let (p, q) = (above[i], below[i]);
+                let nb = normals[k - 1][i];
+                let b = (p.truncate() - q.truncate()).dot(nb);
+                let dd = disp[k][i] * normals[k][i].dot(nb) - disp[k - 1][i];
+                let limit = (p.z - q.z).max(0.0) * tan_limit;
+                let allowed = if dd > 1e-12 {
+                    (limit - b) / dd
+                } else if dd < -1e-12 {
+                    (limit + b) / -dd
+                } else {
+                    1.0
+                };
+                let allowed = allowed.clamp(0.0, 1.0);
+                if allowed < scale[c].0 {
+                    scale[c] = (allowed, k);
+                }
             }
         }
-    }
+        scale
+    });
     let mut events = Vec::new();
     for (i, &(s, k)) in scale.iter().enumerate() {
         if s < 1.0 - 1e-9 {
@@ -117,14 +137,17 @@ pub fn apply_displacements(
             });
         }
     }
-    for (k, section) in sections.iter_mut().enumerate() {
-        for (i, p) in section.points.iter_mut().enumerate() {
-            let s = if enforce { scale[i].0 } else { 1.0 };
-            let shift = normals[k][i] * (disp[k][i] * s);
-            p.x += shift.x;
-            p.y += shift.y;
+    crate::parallel::for_each_part(sections, 64, |first, part| {
+        for (j, section) in part.iter_mut().enumerate() {
+            let k = first + j;
+            for (i, p) in section.points.iter_mut().enumerate() {
+                let s = if enforce { scale[i].0 } else { 1.0 };
+                let shift = normals[k][i] * (disp[k][i] * s);
+                p.x += shift.x;
+                p.y += shift.y;
+            }
         }
-    }
+    });
     events
 }
 

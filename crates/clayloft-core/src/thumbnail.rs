@@ -16,6 +16,10 @@ use glam::{DVec2, DVec3};
 /// The sizes written: a small one for printer screens, a larger one for host web pages.
 pub const SIZES: [(u32, u32); 2] = [(32, 32), (220, 220)];
 
+/// Points drawn at most (about one per pixel of the larger picture): a caller may thin a longer
+/// path to this many before handing it over.
+pub const MAX_DRAWN: usize = 40_000;
+
 /// Draws `points` (bed frame, mm) into a `w` × `h` RGBA picture.
 pub fn render(points: &[DVec3], w: u32, h: u32) -> image::RgbaImage {
     let mut img = image::RgbaImage::new(w, h);
@@ -25,7 +29,7 @@ pub fn render(points: &[DVec3], w: u32, h: u32) -> image::RgbaImage {
     // View: turned 30° about the vertical, looking down 20°.
     let (yaw, pitch) = (30f64.to_radians(), 20f64.to_radians());
     // About one point per pixel (at least a thousand) is enough to draw the vessel.
-    let step = (points.len() / ((w * h) as usize).clamp(1_000, 40_000)).max(1);
+    let step = (points.len() / ((w * h) as usize).clamp(1_000, MAX_DRAWN)).max(1);
     let drawn = points.iter().step_by(step);
     let centre = drawn.clone().fold(DVec3::ZERO, |a, p| a + *p) / drawn.count() as f64;
     let project = |p: DVec3| -> (DVec2, f64) {

@@ -99,11 +99,6 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     let a = p.min_layer_height;
     let base = design.shape.base_layers.min(layers.saturating_sub(1));
     let n = sections[0].points.len();
-    let mut b = PathBuilder {
-        points: Vec::with_capacity((layers + 2) * (n + 1)),
-        speed: p.print_speed,
-    };
-
     let mut layer_starts = Vec::with_capacity(layers + base + 2);
     // 1. Spiral base: layers 1 ..= base, alternating direction so the last one ends at the wall.
     //    All layers share one ring layout (from the widest), so their rings stack.
@@ -124,6 +119,11 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
             ),
         ));
     }
+    // One allocation for the whole path (it is the job's largest buffer: growing it would copy it).
+    let mut b = PathBuilder {
+        points: Vec::with_capacity((base_points + wall_points) as usize),
+        speed: p.print_speed,
+    };
     for layer in 1..=base {
         let geometry = base_layer(&sections[layer], surface.center, rings, layer as f64 * h)
             .ok_or_else(|| {
@@ -146,7 +146,6 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
     }
     let base_points = b.points.len();
-
     // 2. Flat first revolution (only without a base: the base's last layer ends with it).
     let first = base.max(1);
     let flat_z = first as f64 * h;
@@ -328,18 +327,30 @@ fn apply_flow_ramps(points: &mut [PathPoint], start_len: f64, end_len: f64) {
     if points.len() < 2 {
         return;
     }
-    let mut s = vec![0.0; points.len()];
-    for i in 1..points.len() {
-        s[i] = s[i - 1] + points[i - 1].pos.distance(points[i].pos);
-    }
-    let total = s[s.len() - 1];
-    for (q, &si) in points.iter_mut().zip(&s) {
-        if start_len > 0.0 && si < start_len {
-            q.flow *= RAMP_FLOW + (1.0 - RAMP_FLOW) * si / start_len;
+    let ramp = |done: f64, len: f64| RAMP_FLOW + (1.0 - RAMP_FLOW) * done / len;
+    // Only the ramps are walked: arc length s from the start, and total − s from the end.
+    if start_len > 0.0 {
+        let mut s = 0.0;
+        for i in 0..points.len() {
+            if i > 0 {
+                s += points[i - 1].pos.distance(points[i].pos);
+            }
+            if s >= start_len {
+                break;
+            }
+            points[i].flow *= ramp(s, start_len);
         }
-        let from_end = total - si;
-        if end_len > 0.0 && from_end < end_len {
-            q.flow *= RAMP_FLOW + (1.0 - RAMP_FLOW) * from_end / end_len;
+    }
+    if end_len > 0.0 {
+        let mut from_end = 0.0;
+        for i in (0..points.len()).rev() {
+            if i + 1 < points.len() {
+                from_end += points[i].pos.distance(points[i + 1].pos);
+            }
+            if from_end >= end_len {
+                break;
+            }
+            points[i].flow *= ramp(from_end, end_len);
         }
     }
 }
