@@ -21,7 +21,7 @@ pub fn join<T>(handle: std::thread::ScopedJoinHandle<'_, T>) -> T {
 fn ranges(len: usize, serial_below: usize) -> Vec<Range<usize>> {
     let threads = cores().min(len.max(1));
     if threads < 2 || len < serial_below {
-        return vec![0..len];
+        return std::iter::once(0..len).collect();
     }
     let chunk = len.div_ceil(threads);
     (0..len)
