@@ -284,11 +284,12 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
         m.min_layer_height,
         m.max_layer_height
     );
-    if job.surface.findings.is_empty() {
+    let findings: Vec<_> = job.findings().collect();
+    if findings.is_empty() {
         println!("corrections: none needed");
     } else {
-        println!("corrections ({}):", job.surface.findings.len());
-        for f in &job.surface.findings {
+        println!("corrections ({}):", findings.len());
+        for f in findings {
             println!("  {f}");
         }
     }

@@ -64,6 +64,7 @@ fn gcode_writing(c: &mut Criterion) {
             base_points: 0,
             revolutions: 1,
             layer_starts: vec![0],
+            findings: Vec::new(),
         }),
     };
     let mut buf = Vec::with_capacity(64 << 20);

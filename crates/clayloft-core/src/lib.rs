@@ -20,6 +20,7 @@
 //! what an edit changed.
 pub mod align;
 pub mod atomic;
+pub mod base_fill;
 pub mod check;
 pub mod constraint;
 pub mod contour;

@@ -41,6 +41,13 @@ pub struct PrintJob {
     pub toolpath: Arc<Toolpath>,
 }
 
+impl PrintJob {
+    /// Everything the stages corrected or found, the surface's first, then the path's.
+    pub fn findings(&self) -> impl Iterator<Item = &Finding> {
+        self.surface.findings.iter().chain(&self.toolpath.findings)
+    }
+}
+
 /// `tan(max_overhang)` with the pipeline's safety margin.
 pub fn overhang_tan_limit(design: &Design) -> f64 {
     design.printer.max_overhang_deg.to_radians().tan() * LIMIT_MARGIN

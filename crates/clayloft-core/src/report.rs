@@ -12,6 +12,8 @@ pub enum FindingKind {
     HorizontalLines,
     /// The texture's amplitude would break the overhang limit.
     Texture,
+    /// The base fill: a foot narrower than a bead somewhere.
+    Base,
 }
 
 /// One correction or violation, over a range of layers.

@@ -1,4 +1,4 @@
-//! The spiral toolpath (SPEC §4): one continuous extrusion path — a spiral base, a flat first
+//! The spiral toolpath (SPEC §4): one continuous extrusion path — a base fill (SPEC §13), a flat first
 //! revolution, a helix whose z rises with arc length while XY blends from section k to k+1, and a
 //! levelled rim.
 //!
@@ -12,6 +12,7 @@ use glam::{DVec2, DVec3};
 
 use crate::design::Design;
 use crate::pipeline::Surface;
+use crate::report::{Finding, FindingKind};
 use crate::section::Section;
 use crate::validate::{FieldError, MAX_PATH_POINTS};
 
@@ -44,6 +45,8 @@ pub struct Toolpath {
     /// Index of the first point of each layer, in order: each base layer, then each wall
     /// revolution (for host layer messages and progress).
     pub layer_starts: Vec<usize>,
+    /// What the path could not do as designed (a foot narrower than a bead), for the report.
+    pub findings: Vec<Finding>,
 }
 
 impl Toolpath {
@@ -100,48 +103,72 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     let base = design.shape.base_layers.min(layers.saturating_sub(1));
     let n = sections[0].points.len();
     let mut layer_starts = Vec::with_capacity(layers + base + 2);
-    // 1. Spiral base: layers 1 ..= base, alternating direction so the last one ends at the wall.
-    //    All layers share one ring layout (from the widest), so their rings stack.
-    let r_max = (1..=base)
-        .flat_map(|k| sections[k].points.iter())
-        .map(|q| q.truncate().distance(surface.center))
-        .fold(0.0, f64::max);
-    let rings = BaseRings::new(r_max, p.line_width);
-    let base_points = base as u128 * (rings.turns as u128 + 1) * n as u128;
     let wall_points = (layers as u128 + 2) * (n as u128 + 1);
-    if base_points + wall_points > MAX_PATH_POINTS as u128 {
-        return Err(FieldError::new(
+    let too_many = |points: u128| {
+        FieldError::new(
             "shape.base_layers",
             format!(
-                "{base} base layers of {} rings of {n} points and the wall make {} points, more than the {MAX_PATH_POINTS} a path may have (a wider bead, fewer samples or fewer base layers)",
-                rings.turns,
-                base_points + wall_points
+                "{base} base layers and the wall make {points} points, more than the {MAX_PATH_POINTS} a path may have (a wider bead, fewer samples or fewer base layers)"
             ),
-        ));
+        )
+    };
+    if wall_points > MAX_PATH_POINTS as u128 {
+        return Err(too_many(wall_points));
+    }
+    // 1. Base: layers 1 ..= base, each the connected ring fill of its own section
+    //    (`base_fill`), from and to the section's point 0; alternate layers run it backwards so
+    //    each starts where the one below ended, and the last ends where the wall starts.
+    let feet: Vec<Vec<DVec2>> = (1..=base).map(|k| sections[k].xy()).collect();
+    let fills = crate::base_fill::fill_feet(&feet, p.line_width).map_err(|e| {
+        FieldError::new(
+            "shape.base_layers",
+            match e {
+                crate::base_fill::FillError::NarrowerThanABead => format!(
+                    "the foot is nowhere as wide as one bead (printer.line_width = {} mm), so no base can be laid; use base_layers = 0 or a wider foot",
+                    p.line_width
+                ),
+                crate::base_fill::FillError::Offset => {
+                    "the foot's outline could not be offset for the base fill; use base_layers = 0"
+                        .to_string()
+                }
+            },
+        )
+    })?;
+    let mut findings = Vec::new();
+    if let Some(spot) = fills.first().and_then(|f| f.narrow) {
+        findings.push(Finding {
+            kind: FindingKind::Base,
+            corrected: false,
+            layers: (1, base),
+            points: spot.points,
+            amount_mm: spot.depth_mm,
+            message: format!(
+                "the foot is narrower than a bead ({} mm) near x = {:.1}, y = {:.1} mm: the base's beads overlap there",
+                p.line_width, spot.at.x, spot.at.y
+            ),
+        });
+    }
+    let base_total: u128 = fills.iter().map(|f| f.path.len() as u128).sum();
+    if base_total + wall_points > MAX_PATH_POINTS as u128 {
+        return Err(too_many(base_total + wall_points));
     }
     // One allocation for the whole path (it is the job's largest buffer: growing it would copy it).
     let mut b = PathBuilder {
-        points: Vec::with_capacity((base_points + wall_points) as usize),
+        points: Vec::with_capacity((base_total + wall_points) as usize),
         speed: p.print_speed,
     };
-    for layer in 1..=base {
-        let geometry = base_layer(&sections[layer], surface.center, rings, layer as f64 * h)
-            .ok_or_else(|| {
-                FieldError::new(
-                    "shape.base_layers",
-                    "the lower contour is not star-shaped around its centre, so a spiral base cannot fill it; use base_layers = 0",
-                )
-            })?;
-        let outward = (base - layer).is_multiple_of(2);
+    for (layer, path) in (1..=base).zip(fills.iter().map(|f| &f.path)) {
+        let z = layer as f64 * h;
+        let forward = (base - layer).is_multiple_of(2);
         let start = b.points.len();
         layer_starts.push(start);
-        let ordered: Box<dyn Iterator<Item = &DVec3>> = if outward {
-            Box::new(geometry.iter())
+        let ordered: Box<dyn Iterator<Item = &DVec2>> = if forward {
+            Box::new(path.iter())
         } else {
-            Box::new(geometry.iter().rev())
+            Box::new(path.iter().rev())
         };
         for q in ordered {
-            b.push(*q, h);
+            b.push(DVec3::new(q.x, q.y, z), h);
         }
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
     }
@@ -237,6 +264,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
         base_points,
         revolutions,
         layer_starts,
+        findings,
     })
 }
 
@@ -246,61 +274,6 @@ fn arc_fractions(section: &Section) -> Vec<f64> {
     let s = crate::geometry::cumulative_length(&xy);
     let total = s[s.len() - 1].max(1e-12);
     s.iter().map(|v| v / total).collect()
-}
-
-/// Ring layout of the spiral base: the scale σ rises from `sigma0` to 1 over `turns` turns.
-#[derive(Debug, Clone, Copy)]
-struct BaseRings {
-    sigma0: f64,
-    turns: usize,
-}
-
-impl BaseRings {
-    /// Turns at most one line width apart at the widest radius `r_max`, and a centre hole of
-    /// half a line width.
-    fn new(r_max: f64, line_width: f64) -> BaseRings {
-        let sigma0 = (0.5 * line_width / r_max.max(1e-9)).min(1.0);
-        let turns = (((1.0 - sigma0) * r_max) / line_width).ceil().max(1.0) as usize;
-        BaseRings { sigma0, turns }
-    }
-}
-
-/// One flat base layer at height `z`: a spiral of the section scaled about the centre,
-/// `c + σ(P_i − c)` with σ following `rings`, then the full perimeter. Ends at the section's
-/// point 0. `None` if the section is not star-shaped around the centre.
-fn base_layer(section: &Section, center: DVec2, rings: BaseRings, z: f64) -> Option<Vec<DVec3>> {
-    let xy = section.xy();
-    let n = xy.len();
-    // Star-shaped: the angle seen from the centre must keep increasing all the way round.
-    let mut total_turn = 0.0;
-    for i in 0..n {
-        let d = crate::control::angle_difference(
-            (xy[(i + 1) % n] - center).to_angle(),
-            (xy[i] - center).to_angle(),
-        );
-        if d <= 0.0 {
-            return None;
-        }
-        total_turn += d;
-    }
-    if (total_turn - std::f64::consts::TAU).abs() > 1e-6 {
-        return None;
-    }
-    let BaseRings { sigma0, turns } = rings;
-    let mut out = Vec::with_capacity((turns + 1) * n + 1);
-    for turn in 0..turns {
-        for (i, p) in xy.iter().enumerate() {
-            let sigma =
-                sigma0 + (1.0 - sigma0) * (turn as f64 + i as f64 / n as f64) / turns as f64;
-            let q = center + (*p - center) * sigma;
-            out.push(DVec3::new(q.x, q.y, z));
-        }
-    }
-    for i in 0..=n {
-        let q = xy[i % n];
-        out.push(DVec3::new(q.x, q.y, z));
-    }
-    Some(out)
 }
 
 /// Slows the revolution `points[start..]` down so that it takes at least `min_time` seconds
@@ -399,17 +372,18 @@ mod tests {
     }
 
     #[test]
-    fn base_spiral_fills_from_the_centre_and_joins_the_wall() {
-        let d = design("").clone();
-        let mut d = d;
+    fn base_fills_from_the_wall_start_to_the_centre_and_back() {
+        let mut d = design("");
         d.shape.base_layers = 2;
         let job = run(&d).unwrap();
         let tp = &job.toolpath;
         assert!(tp.base_points > 0);
         let c = job.surface.center;
-        // Two base layers: first inward (starts at the edge), second outward (starts at centre).
-        let first = tp.points[0].pos.truncate();
-        assert!((first.distance(c) - 30.0).abs() < 1e-6);
+        // Each base layer starts and ends at the wall's point 0 (on the outline), so the layers
+        // and the wall join without travel; the rings reach the centre.
+        let start = job.surface.sections[1].points[0].truncate();
+        assert!(tp.points[0].pos.truncate().distance(start) < 1e-6);
+        assert!(tp.points[tp.base_points - 1].pos.truncate().distance(start) < 1e-6);
         let nearest = tp.points[..tp.base_points]
             .iter()
             .map(|q| q.pos.truncate().distance(c))
@@ -421,6 +395,71 @@ mod tests {
                 .iter()
                 .all(|q| q.pos.z == 1.0 || q.pos.z == 2.0)
         );
+    }
+
+    /// The first base layer of a job: its XY path and bead length over the foot's area times
+    /// the bead width (1 = exactly the clay the area needs), and its raster coverage.
+    fn first_base_layer(job: &crate::PrintJob, w: f64) -> (f64, crate::base_fill::Coverage) {
+        let tp = &job.toolpath;
+        let end = tp.layer_starts.get(1).copied().unwrap_or(tp.base_points);
+        let path: Vec<DVec2> = tp.points[..end].iter().map(|q| q.pos.truncate()).collect();
+        let foot = job.surface.sections[1].xy();
+        let length: f64 = path.windows(2).map(|s| s[0].distance(s[1])).sum();
+        let area = crate::geometry::signed_area(&foot);
+        // The outline's bead lies half outside the foot.
+        let needed = area / w + 0.5 * crate::geometry::closed_length(&foot);
+        (
+            length / needed,
+            crate::base_fill::coverage(&path, &foot, w, w / 8.0),
+        )
+    }
+
+    #[test]
+    fn feet_no_spiral_could_fill_get_a_base_of_the_clay_they_need() {
+        // The five-point star (x-extremes midpoint off its centre: not star-shaped
+        // around the anchor) and its six-point star that got 3.5 times the clay.
+        for (points, outer, inner) in [(5, 50.0, 22.0), (6, 50.0, 22.0)] {
+            let star = format!(
+                "type = \"star\"\npoints = {points}\nouter_radius = {outer}\ninner_radius = {inner}\n"
+            );
+            let d = parse_design(&format!(
+                "version = 1\n[shape]\nheight = 10.0\nsamples = 360\nbase_layers = 2\n[shape.lower]\n{star}[shape.upper]\n{star}"
+            ))
+            .unwrap();
+            let job = run(&d).unwrap();
+            let w = d.printer.line_width;
+            let (clay, cov) = first_base_layer(&job, w);
+            assert!(
+                (0.9..1.15).contains(&clay),
+                "{points}-point star: {clay} times the clay"
+            );
+            assert!(
+                cov.uncovered < 0.02 && cov.doubled < 0.05,
+                "{points}-point star: {cov:?}"
+            );
+            // One continuous path: no step longer than a bridge.
+            let longest = job.toolpath.points[..job.toolpath.base_points + 1]
+                .windows(2)
+                .map(|s| s[0].pos.truncate().distance(s[1].pos.truncate()))
+                .fold(0.0, f64::max);
+            assert!(longest < 2.0 * w, "{longest}");
+        }
+    }
+
+    #[test]
+    fn a_traced_leaf_and_an_l_planter_are_covered_evenly() {
+        for name in ["leaf-dish", "l-planter"] {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("../../assets/designs/{name}.toml"));
+            let loaded = crate::load_design(&path).unwrap();
+            let job = run(&loaded.design).unwrap();
+            let (clay, cov) = first_base_layer(&job, loaded.design.printer.line_width);
+            assert!((0.9..1.15).contains(&clay), "{name}: {clay} times the clay");
+            assert!(
+                cov.uncovered < 0.02 && cov.doubled < 0.05,
+                "{name}: {cov:?}"
+            );
+        }
     }
 
     #[test]
@@ -477,7 +516,8 @@ mod properties {
             }).fold(0.0, f64::max);
             for w in pts.windows(2) {
                 let seg = w[0].pos.truncate().distance(w[1].pos.truncate());
-                prop_assert!(seg > 0.0 && seg <= widest + d.printer.line_width, "segment {seg} > {widest}");
+                // The base's bridges and corner spurs step about a bead.
+                prop_assert!(seg > 0.0 && seg <= widest + 1.5 * d.printer.line_width, "segment {seg} > {widest}");
             }
             for q in pts {
                 prop_assert!(q.thickness >= d.printer.min_layer_height - 1e-9, "thin {}", q.thickness);

@@ -204,7 +204,7 @@ fn draw_panels(
                 replay_panel(ui, &mut edited, &replay_path);
                 replay.set_if_neq(edited);
                 ui.separator();
-                findings_panel(ui, vessel.iter().next(), &design);
+                findings_panel(ui, vessel.iter().next(), toolpath.iter().next(), &design);
             });
         });
 
@@ -311,6 +311,7 @@ fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
 fn findings_panel(
     ui: &mut egui::Ui,
     surface: Option<&VesselSurface>,
+    path: Option<&ToolpathPath>,
     design: &clayloft_core::Design,
 ) {
     ui.heading("Constraints");
@@ -323,13 +324,14 @@ fn findings_panel(
         .weak(),
     );
     let Some(s) = surface else { return };
-    if s.0.findings.is_empty() {
+    let path_findings = path.map(|p| p.0.findings.as_slice()).unwrap_or_default();
+    if s.0.findings.is_empty() && path_findings.is_empty() {
         ui.colored_label(
             egui::Color32::from_rgb(150, 220, 150),
             "the design keeps every limit as drawn",
         );
     }
-    for f in &s.0.findings {
+    for f in s.0.findings.iter().chain(path_findings) {
         let color = if f.corrected {
             egui::Color32::from_rgb(240, 200, 90)
         } else {

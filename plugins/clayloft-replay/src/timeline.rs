@@ -73,6 +73,7 @@ mod tests {
             base_points: 0,
             revolutions: 1,
             layer_starts: vec![0],
+            findings: Vec::new(),
         };
         let tl = Timeline::new(&path);
         assert_eq!(tl.total_s(), 2.0);

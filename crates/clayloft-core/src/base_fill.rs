@@ -1,0 +1,821 @@
+//! Base fill (SPEC §13): one continuous path that covers any flat, simple closed foot with beads
+//! one line width apart — connected contour-parallel offsets.
+//!
+//! **Rings.** The foot's inward offsets by w, 2w, 3w, … (w the line width), each offset from the
+//! foot itself (with `cavalier_contours`, so errors do not pile up and splits, pinches and
+//! vanishing lobes come out right), and one more at (j + ½)·w inside a ring at level j that has
+//! no ring one level in but is still wider than a bead in the middle. They form a tree: a ring's
+//! children are the next level's rings inside it (an offset splits where the foot has a waist).
+//! The root is the foot itself: the wall's first bead.
+//!
+//! **Bridges.** The path walks the tree depth first, once round each ring anticlockwise. It
+//! visits a child through a bridge: from the parent ring at q_in it steps in to the child at e,
+//! goes round the child to x (one line width before e) and steps back out to q_out on the parent.
+//! Every point of a ring of level j + 1 lies exactly w from the ring of level j around it (the
+//! offsets are erosions of the foot by growing discs), so both steps are one bead long and lie in
+//! the strip between the two rings, which no other ring enters; facing rings run in opposite
+//! directions (the orientation alternates), so the parent reaches q_in first and the two steps do
+//! not cross. Bridges on one
+//! ring are kept apart, and away from the ring's own bridge, by a bead.
+//!
+//! The layer starts and ends at the foot's point 0, so base layers stack without a travel move
+//! (alternate layers run the same path backwards) and the last ends where the wall begins.
+
+use cavalier_contours::polyline::{PlineCreation, PlineSource, PlineSourceMut, Polyline};
+use glam::DVec2;
+
+/// Largest deviation of the drawn offset rings from their arcs, mm (far below a bead).
+const ARC_TOLERANCE_MM: f64 = 0.01;
+
+/// Why a foot cannot be filled.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FillError {
+    /// No part of the foot is as wide as one bead.
+    NarrowerThanABead,
+    /// The offset of the outline failed (a foot the offsetting library cannot handle).
+    Offset,
+}
+
+/// A place where the foot is narrower than one bead: the beads on either side overlap there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NarrowSpot {
+    /// Foot outline points narrower than a bead.
+    pub points: usize,
+    /// The narrowest of them (where the foot is farthest from fitting a bead).
+    pub at: DVec2,
+    /// How far that point lies from the bead-wide part of the foot, mm.
+    pub depth_mm: f64,
+}
+
+/// One base layer's path (XY, starting and ending at `foot[0]`) and where the foot is too narrow.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BaseFill {
+    pub path: Vec<DVec2>,
+    pub narrow: Option<NarrowSpot>,
+}
+
+/// A closed ring with its arc length at each vertex (`cum[n]` = the ring's length).
+#[derive(Debug, Clone)]
+struct Ring {
+    pts: Vec<DVec2>,
+    cum: Vec<f64>,
+    /// Spurs into the sharp corners the ring around leaves uncovered: (vertex, tip), by vertex.
+    spurs: Vec<(usize, DVec2)>,
+}
+
+impl Ring {
+    fn new(pts: Vec<DVec2>) -> Ring {
+        let cum = crate::geometry::cumulative_length(&pts);
+        Ring {
+            pts,
+            cum,
+            spurs: Vec::new(),
+        }
+    }
+
+    fn len(&self) -> f64 {
+        self.cum[self.pts.len()]
+    }
+
+    /// The point at arc length `s` (taken modulo the length).
+    fn at(&self, s: f64) -> DVec2 {
+        let s = s.rem_euclid(self.len());
+        let i = self
+            .cum
+            .partition_point(|&c| c <= s)
+            .clamp(1, self.pts.len())
+            - 1;
+        let (a, b) = (self.pts[i], self.pts[(i + 1) % self.pts.len()]);
+        let seg = self.cum[i + 1] - self.cum[i];
+        let f = if seg > 0.0 {
+            (s - self.cum[i]) / seg
+        } else {
+            0.0
+        };
+        a.lerp(b, f)
+    }
+
+    /// Arc length of the ring point nearest to `p`, and its distance.
+    fn nearest(&self, p: DVec2) -> (f64, f64) {
+        let n = self.pts.len();
+        let mut best = (0.0, f64::INFINITY);
+        for i in 0..n {
+            let (d, f) =
+                crate::geometry::point_segment_distance(p, self.pts[i], self.pts[(i + 1) % n]);
+            if d < best.1 {
+                best = (self.cum[i] + f * (self.cum[i + 1] - self.cum[i]), d);
+            }
+        }
+        best
+    }
+
+    /// Appends the vertices strictly after arc length `from` and before `to` (going forward,
+    /// `from ≤ to ≤ from + len`), then the point at `to`.
+    fn walk(&self, from: f64, to: f64, out: &mut Vec<DVec2>) {
+        let (n, len) = (self.pts.len(), self.len());
+        let turns = (from / len).floor();
+        let mut i = self.cum.partition_point(|&c| c <= from.rem_euclid(len));
+        let mut base = turns * len;
+        loop {
+            if i >= n {
+                i = 0;
+                base += len;
+            }
+            let s = base + self.cum[i];
+            if s >= to - 1e-9 {
+                break;
+            }
+            if s > from + 1e-9 {
+                out.push(self.pts[i]);
+                if let Ok(k) = self.spurs.binary_search_by_key(&i, |sp| sp.0) {
+                    out.push(self.spurs[k].1);
+                    out.push(self.pts[i]);
+                }
+            }
+            i += 1;
+        }
+        out.push(self.at(to));
+    }
+}
+
+/// A ring and the rings one level in that lie inside it.
+#[derive(Debug, Clone)]
+struct Node {
+    ring: Ring,
+    /// How far inside the ring around it this ring lies, mm (w, or w/2 for a middle ring; 0
+    /// for the foot).
+    step: f64,
+    children: Vec<Node>,
+}
+
+/// The foot as a closed polyline for the offsetting library (anticlockwise, no repeated points).
+fn polyline(foot: &[DVec2]) -> Polyline<f64> {
+    let mut pl = Polyline::with_capacity(foot.len(), true);
+    for p in crate::geometry::dedup_closed(foot) {
+        pl.add(p.x, p.y, 0.0);
+    }
+    pl
+}
+
+/// The foot's inward offset by `d`: its rings, drawn with straight segments, anticlockwise.
+fn offset(foot: &Polyline<f64>, d: f64) -> Result<Vec<Vec<DVec2>>, FillError> {
+    let loops = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        foot.parallel_offset(d)
+            .into_iter()
+            .map(|pl| pl.arcs_to_approx_lines(ARC_TOLERANCE_MM).unwrap_or(pl))
+            .collect::<Vec<_>>()
+    }))
+    .map_err(|_| FillError::Offset)?;
+    Ok(loops
+        .into_iter()
+        .filter(|pl| pl.is_closed() && pl.vertex_count() >= 3)
+        .map(|pl| {
+            let mut pts: Vec<DVec2> = (0..pl.vertex_count())
+                .map(|i| {
+                    let v = pl.at(i);
+                    DVec2::new(v.x, v.y)
+                })
+                .collect();
+            if crate::geometry::signed_area(&pts) < 0.0 {
+                pts.reverse();
+            }
+            without_spikes(pts)
+        })
+        .filter(|pts| pts.len() >= 3 && crate::geometry::signed_area(pts) > 1e-9)
+        .collect())
+}
+
+/// A ring without repeated points and without spikes (a vertex where the ring turns straight
+/// back: the offsetting library can close a ring by going back over its first segment).
+fn without_spikes(mut pts: Vec<DVec2>) -> Vec<DVec2> {
+    loop {
+        pts = crate::geometry::dedup_closed(&pts);
+        let n = pts.len();
+        if n < 3 {
+            return pts;
+        }
+        let spike = (0..n).find(|&i| {
+            let (a, b, c) = (pts[(i + n - 1) % n], pts[i], pts[(i + 1) % n]);
+            let (u, v) = (b - a, c - b);
+            u.dot(v) < 0.0 && u.perp_dot(v).abs() <= 1e-9 * u.length() * v.length()
+        });
+        match spike {
+            Some(i) => {
+                pts.remove(i);
+            }
+            None => return pts,
+        }
+    }
+}
+
+/// True when `p` lies inside the closed polyline (even–odd rule).
+fn contains(poly: &[DVec2], p: DVec2) -> bool {
+    let n = poly.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// The ring tree of a foot (module documentation): levels j·w, and (j + ½)·w in the middle of
+/// rings that end before the next level.
+fn ring_tree(foot: &[DVec2], w: f64) -> Result<Node, FillError> {
+    let pl = polyline(foot);
+    let (lo, hi) = foot.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    // No ring lies deeper than half the foot's smaller extent: a bound on the levels.
+    let max_levels = (((hi - lo).min_element() / 2.0) / w).ceil() as usize + 1;
+    let mut levels: Vec<Vec<Vec<DVec2>>> = Vec::new();
+    for j in 1..=max_levels {
+        let loops = offset(&pl, j as f64 * w)?;
+        if loops.is_empty() {
+            break;
+        }
+        levels.push(loops);
+    }
+    // Each level's rings become children of the ring of the level above that holds them; the
+    // half-level rings go under the rings they lie in when no deeper ring covers them.
+    let mut nodes: Vec<Vec<Node>> = Vec::new();
+    for (j, loops) in levels.iter().enumerate() {
+        let mut level: Vec<Node> = loops
+            .iter()
+            .map(|l| Node {
+                ring: Ring::new(l.clone()),
+                step: w,
+                children: Vec::new(),
+            })
+            .collect();
+        let half = offset(&pl, (j as f64 + 1.5) * w)?;
+        let deeper = levels.get(j + 1);
+        for h in half {
+            let covered = deeper.is_some_and(|d| d.iter().any(|r| contains(&h, r[0])));
+            if covered {
+                continue;
+            }
+            if let Some(parent) = level.iter_mut().find(|n| contains(&n.ring.pts, h[0])) {
+                parent.children.push(Node {
+                    ring: Ring::new(h),
+                    step: 0.5 * w,
+                    children: Vec::new(),
+                });
+            }
+        }
+        nodes.push(level);
+    }
+    let mut root = Node {
+        ring: Ring::new(foot.to_vec()),
+        step: 0.0,
+        children: Vec::new(),
+    };
+    // Attach bottom-up: level j + 1 into level j, level 1 into the foot.
+    while let Some(level) = nodes.pop() {
+        let parents: Vec<&mut Node> = match nodes.last_mut() {
+            Some(above) => above.iter_mut().collect(),
+            None => vec![&mut root],
+        };
+        let mut parents = parents;
+        for node in level {
+            let p = node.ring.pts[0];
+            let k = parents
+                .iter()
+                .position(|n| contains(&n.ring.pts, p))
+                .unwrap_or(0);
+            parents[k].children.push(node);
+        }
+    }
+    orient(&mut root, true, w);
+    Ok(root)
+}
+
+/// Turns the rings so that each runs opposite to its parent (the foot anticlockwise): where two
+/// rings face each other across a bridge they then run in opposite directions.
+fn orient(node: &mut Node, anticlockwise: bool, w: f64) {
+    if (crate::geometry::signed_area(&node.ring.pts) > 0.0) != anticlockwise {
+        let mut pts = std::mem::take(&mut node.ring.pts);
+        pts.reverse();
+        // Keep the same first point.
+        pts.rotate_right(1);
+        node.ring = Ring::new(pts);
+    }
+    if node.step > 0.0 {
+        node.ring.spurs = corner_spurs(&node.ring, anticlockwise, node.step, w);
+    }
+    for child in &mut node.children {
+        orient(child, !anticlockwise, w);
+    }
+}
+
+/// Turns of at least this much within half a bead of ring make a sharp corner (radians; an
+/// interior angle under 100°).
+const SHARP_TURN: f64 = 80.0 * std::f64::consts::PI / 180.0;
+
+/// The share of a corner's gap a spur reaches into (see [`corner_spurs`]): with 0.6, a deep
+/// star's points are neither left bare nor doubled past the bounds.
+const SPUR_REACH: f64 = 0.6;
+
+/// Spurs into sharp corners. At a convex corner of interior angle θ a ring lying `step` inside
+/// the ring around it has its corner `step / s` from the outer corner along the bisector
+/// (s = sin(θ/2)); the outer bead covers `(w/2) / s` of that and this ring's bead `w/2`, so a
+/// spur of length `(step − w/2)/s − w/2` out along the bisector (and back) closes the gap.
+fn corner_spurs(ring: &Ring, anticlockwise: bool, step: f64, w: f64) -> Vec<(usize, DVec2)> {
+    let (pts, n) = (&ring.pts, ring.pts.len());
+    let sign = if anticlockwise { 1.0 } else { -1.0 };
+    let dir = |i: usize| (pts[(i + 1) % n] - pts[i]).normalize_or_zero();
+    // Convex turn at each vertex (positive toward the ring's inside).
+    let turn: Vec<f64> = (0..n)
+        .map(|i| {
+            let (a, b) = (dir((i + n - 1) % n), dir(i));
+            sign * a.perp_dot(b).atan2(a.dot(b))
+        })
+        .collect();
+    let mut spurs = Vec::new();
+    for i in 0..n {
+        if turn[i] <= 0.0 {
+            continue;
+        }
+        // The vertices within half a bead on either side that turn the same way.
+        let (mut lo, mut hi, mut total) = (i, i, turn[i]);
+        let mut is_peak = true;
+        for k in 1..n / 2 {
+            let j = (i + n - k) % n;
+            if ring.pts[j].distance(pts[i]) > 0.5 * w || turn[j] <= 0.0 {
+                break;
+            }
+            is_peak &= turn[j] < turn[i];
+            total += turn[j];
+            lo = j;
+        }
+        for k in 1..n / 2 {
+            let j = (i + k) % n;
+            if ring.pts[j].distance(pts[i]) > 0.5 * w || turn[j] <= 0.0 {
+                break;
+            }
+            is_peak &= turn[j] <= turn[i];
+            total += turn[j];
+            hi = j;
+        }
+        // Past 150° the ring turns back on itself (the end of a thin ring), not into a corner.
+        if !is_peak || !(SHARP_TURN..=150f64.to_radians()).contains(&total) {
+            continue;
+        }
+        let s = (0.5 * total).cos();
+        // Part of the gap only: near its far end the outer bead's sides close in, and a spur
+        // all the way would lay a second bead over them. At most a bead long.
+        let length = (SPUR_REACH * ((step - 0.5 * w) / s - 0.5 * w)).min(w);
+        if length <= 0.1 * w {
+            continue;
+        }
+        let (u_in, u_out) = (dir((lo + n - 1) % n), dir(hi));
+        let out = (u_in - u_out).normalize_or_zero();
+        if out != DVec2::ZERO {
+            spurs.push((i, pts[i] + out * length));
+        }
+    }
+    spurs
+}
+
+/// The part of a child ring a bridge leaves out, in beads: half a bead, so that the parent's
+/// gap is short enough for the layer above to rest on the bridge's two steps (a point over the
+/// middle of the gap lies a quarter bead from them).
+const BRIDGE_GAP_BEADS: f64 = 0.5;
+
+/// Where a child is entered and left: arc lengths on the parent (`s_in < s_out`, relative to
+/// where the parent's walk starts) and the entry on the child.
+#[derive(Debug, Clone, Copy)]
+struct Bridge {
+    s_in: f64,
+    s_out: f64,
+    child_entry: f64,
+}
+
+/// The bridge into `child` entered at `e` (arc length on the child), seen from `parent`'s walk
+/// that starts at `start`: `None` when the two steps land in the wrong order.
+fn bridge_at(parent: &Ring, child: &Ring, start: f64, e: f64, w: f64) -> Option<Bridge> {
+    let len = parent.len();
+    let (s_e, _) = parent.nearest(child.at(e));
+    let (s_x, _) = parent.nearest(child.at(e - BRIDGE_GAP_BEADS * w));
+    let s_in = (s_e - start).rem_euclid(len);
+    let mut s_out = (s_x - start).rem_euclid(len);
+    if s_out < s_in && s_in - s_out > 0.5 * len {
+        s_out += len;
+    }
+    (s_out > s_in).then_some(Bridge {
+        s_in,
+        s_out,
+        child_entry: e,
+    })
+}
+
+/// Places the bridges of `node`'s children on its walk of `span` (arc lengths `0 ..= span`
+/// after `start`): a bead apart and a bead from the walk's ends, each where the parent's gap is
+/// closest to the child's (candidate entries every half bead round the child). With
+/// `late`, among gaps within a quarter bead of the best the one latest on the walk is taken: on
+/// the outline, the wall's first revolution rises from the minimum layer height to a full layer,
+/// and rests on the bridge's steps best where it is thickest.
+fn bridges(node: &Node, start: f64, span: f64, w: f64, late: bool) -> Vec<(Bridge, usize)> {
+    let mut taken: Vec<(f64, f64)> = Vec::new();
+    let mut out = Vec::new();
+    let want = BRIDGE_GAP_BEADS * w;
+    for (c, child) in node.children.iter().enumerate() {
+        let clen = child.ring.len();
+        let steps = ((clen / (0.5 * w)).ceil() as usize).max(1);
+        let mut fits: Vec<(f64, Bridge)> = Vec::new();
+        for k in 0..steps {
+            let e = k as f64 * clen / steps as f64;
+            let Some(b) = bridge_at(&node.ring, &child.ring, start, e, w) else {
+                continue;
+            };
+            let (lo, hi) = (b.s_in - 0.5 * w, b.s_out + 0.5 * w);
+            if lo < w || hi > span - w || !taken.iter().all(|&(x, y)| hi < x || lo > y) {
+                continue;
+            }
+            fits.push((((b.s_out - b.s_in) - want).abs(), b));
+        }
+        let least = fits.iter().map(|f| f.0).fold(f64::INFINITY, f64::min);
+        let pick = if late {
+            fits.iter()
+                .filter(|f| f.0 <= least + 0.25 * w)
+                .max_by(|a, b| a.1.s_in.total_cmp(&b.1.s_in))
+        } else {
+            fits.iter().find(|f| f.0 <= least + 1e-9)
+        };
+        // No room anywhere (a ring crowded by its siblings' bridges): it is left out.
+        let Some(&(_, b)) = pick else { continue };
+        taken.push((b.s_in - 0.5 * w, b.s_out + 0.5 * w));
+        out.push((b, c));
+    }
+    out.sort_by(|a, b| a.0.s_in.total_cmp(&b.0.s_in));
+    out
+}
+
+/// Walks `node` from arc length `start` for `span`, visiting its children by their bridges
+/// (`entries`: where to enter each child, if already chosen).
+fn walk_node(
+    node: &Node,
+    start: f64,
+    span: f64,
+    w: f64,
+    entries: Option<&[(Bridge, usize)]>,
+    out: &mut Vec<DVec2>,
+) {
+    out.push(node.ring.at(start));
+    let mut at = 0.0;
+    let placed = match entries {
+        Some(e) => e
+            .iter()
+            .filter_map(|(b, c)| {
+                bridge_at(&node.ring, &node.children[*c].ring, start, b.child_entry, w)
+                    .map(|b| (b, *c))
+            })
+            .collect(),
+        None => bridges(node, start, span, w, false),
+    };
+    for (bridge, c) in placed {
+        if bridge.s_in < at {
+            continue;
+        }
+        node.ring.walk(start + at, start + bridge.s_in, out);
+        let child = &node.children[c];
+        let clen = child.ring.len();
+        let child_span = clen - (BRIDGE_GAP_BEADS * w).min(0.5 * clen);
+        walk_node(child, bridge.child_entry, child_span, w, None, out);
+        out.push(node.ring.at(start + bridge.s_out));
+        at = bridge.s_out;
+    }
+    node.ring.walk(start + at, start + span, out);
+}
+
+/// Foot outline points farther than a bead from the part of the foot a bead fits in (the foot
+/// eroded by half a bead): there the foot is narrower than a bead.
+fn narrow_spot(foot: &[DVec2], eroded: &[Vec<DVec2>], w: f64) -> Option<NarrowSpot> {
+    let rings: Vec<Ring> = eroded.iter().map(|l| Ring::new(l.clone())).collect();
+    let mut spot: Option<NarrowSpot> = None;
+    let mut count = 0;
+    for &p in foot {
+        let d = rings
+            .iter()
+            .map(|r| r.nearest(p).1)
+            .fold(f64::INFINITY, f64::min);
+        // A straight or gently curved wall lies w/2 from the eroded foot; a corner of angle θ
+        // lies (w/2)/sin(θ/2): more than w only for corners sharper than about 60°, or where a
+        // whole arm is missing from the eroded foot.
+        if d > w * 1.01 {
+            count += 1;
+            if spot.is_none_or(|s| d > s.depth_mm) {
+                spot = Some(NarrowSpot {
+                    points: 0,
+                    at: p,
+                    depth_mm: d,
+                });
+            }
+        }
+    }
+    spot.map(|s| NarrowSpot { points: count, ..s })
+}
+
+/// The base layer path of a foot (its outline anticlockwise, point 0 where the wall starts) for
+/// beads `w` wide: starts and ends at `foot[0]` (see the module documentation).
+pub fn fill_foot(foot: &[DVec2], w: f64) -> Result<BaseFill, FillError> {
+    let mut fills = fill_feet(&[foot.to_vec()], w)?;
+    Ok(fills.remove(0))
+}
+
+/// The paths of several base layers, one per foot (bottom up): the rings inside are those of the
+/// first foot on every layer, so that each layer's beads lie on the beads below; only the
+/// outline (and the bridge from it) follows each layer's own foot.
+pub fn fill_feet(feet: &[Vec<DVec2>], w: f64) -> Result<Vec<BaseFill>, FillError> {
+    let Some(first) = feet.first() else {
+        return Ok(Vec::new());
+    };
+    if feet.iter().any(|f| f.len() < 3) || w.is_nan() || w <= 0.0 {
+        return Err(FillError::NarrowerThanABead);
+    }
+    let eroded = offset(&polyline(first), 0.5 * w)?;
+    if eroded.is_empty() {
+        return Err(FillError::NarrowerThanABead);
+    }
+    let narrow = narrow_spot(first, &eroded, w);
+    let inner = ring_tree(first, w)?;
+    // The bridges from the outline are placed on the first foot and entered at the same points
+    // of the inner rings on every layer, so that the layers' bridges stack.
+    let first_root = Node {
+        ring: Ring::new(first.clone()),
+        step: 0.0,
+        children: inner.children.clone(),
+    };
+    let entries = bridges(&first_root, 0.0, first_root.ring.len(), w, true);
+    Ok(feet
+        .iter()
+        .map(|foot| {
+            let root = Node {
+                ring: Ring::new(foot.clone()),
+                step: 0.0,
+                children: inner.children.clone(),
+            };
+            let mut path = Vec::new();
+            walk_node(&root, 0.0, root.ring.len(), w, Some(&entries), &mut path);
+            path.dedup_by(|a, b| a.distance(*b) < 1e-9);
+            BaseFill { path, narrow }
+        })
+        .collect())
+}
+
+/// How evenly a base layer covers its foot, measured on a raster (cells `cell` mm wide): the
+/// number of passes of a bead `w` wide over each cell inside the foot (a pass: the path coming
+/// within w/2 of the cell centre; running on along the path within 1.5 w counts as the same
+/// pass). With one layer's thickness per pass, a cell with no pass is under half the layer
+/// height and one with two or more is over 1.6 times it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coverage {
+    /// Share of the foot's area with no bead.
+    pub uncovered: f64,
+    /// Share of the foot's area with two or more beads.
+    pub doubled: f64,
+}
+
+/// The [`Coverage`] of `path` over `foot` (see there).
+pub fn coverage(path: &[DVec2], foot: &[DVec2], w: f64, cell: f64) -> Coverage {
+    let (lo, hi) = foot.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let (lo, hi) = (lo - w, hi + w);
+    let nx = ((hi.x - lo.x) / cell).ceil() as usize;
+    let ny = ((hi.y - lo.y) / cell).ceil() as usize;
+    let mut passes = vec![0u16; nx * ny];
+    let mut last = vec![f64::NEG_INFINITY; nx * ny];
+    let r = 0.5 * w;
+    let mut s = 0.0;
+    for seg in path.windows(2) {
+        let (a, b) = (seg[0], seg[1]);
+        let len = a.distance(b);
+        let (x0, x1) = (
+            ((a.x.min(b.x) - r - lo.x) / cell).floor().max(0.0) as usize,
+            (((a.x.max(b.x) + r - lo.x) / cell).ceil() as usize).min(nx),
+        );
+        let (y0, y1) = (
+            ((a.y.min(b.y) - r - lo.y) / cell).floor().max(0.0) as usize,
+            (((a.y.max(b.y) + r - lo.y) / cell).ceil() as usize).min(ny),
+        );
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let c = lo + DVec2::new((x as f64 + 0.5) * cell, (y as f64 + 0.5) * cell);
+                let (d, f) = crate::geometry::point_segment_distance(c, a, b);
+                if d <= r {
+                    let at = s + f * len;
+                    let k = y * nx + x;
+                    if at - last[k] > 1.5 * w {
+                        passes[k] = passes[k].saturating_add(1);
+                    }
+                    last[k] = at;
+                }
+            }
+        }
+        s += len;
+    }
+    let (mut inside, mut none, mut two) = (0usize, 0usize, 0usize);
+    for y in 0..ny {
+        for x in 0..nx {
+            let c = lo + DVec2::new((x as f64 + 0.5) * cell, (y as f64 + 0.5) * cell);
+            if contains(foot, c) {
+                inside += 1;
+                match passes[y * nx + x] {
+                    0 => none += 1,
+                    1 => {}
+                    _ => two += 1,
+                }
+            }
+        }
+    }
+    let inside = inside.max(1) as f64;
+    Coverage {
+        uncovered: none as f64 / inside,
+        doubled: two as f64 / inside,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    const W: f64 = 1.2;
+
+    fn polar(n: usize, r: impl Fn(f64) -> f64) -> Vec<DVec2> {
+        (0..n)
+            .map(|i| {
+                let a = TAU * i as f64 / n as f64;
+                DVec2::from_angle(a) * r(a)
+            })
+            .collect()
+    }
+
+    /// The closed polygon with corners `c`, resampled at `n` points (point 0 at the first).
+    fn polygon(c: &[(f64, f64)], n: usize) -> Vec<DVec2> {
+        let pts: Vec<DVec2> = c.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
+        crate::geometry::resample_closed(&pts, n)
+    }
+
+    /// Fills a foot and checks the path: continuous (no step longer than two beads), from and
+    /// to point 0, never crossing itself, covering the foot within the bounds.
+    fn check(name: &str, foot: &[DVec2]) -> BaseFill {
+        let fill = fill_foot(foot, W).unwrap();
+        let p = &fill.path;
+        assert!(
+            p[0].distance(foot[0]) < 1e-9 && p[p.len() - 1].distance(foot[0]) < 1e-9,
+            "{name}"
+        );
+        let longest = p
+            .windows(2)
+            .map(|s| s[0].distance(s[1]))
+            .fold(0.0, f64::max);
+        let outline_step = foot
+            .windows(2)
+            .map(|s| s[0].distance(s[1]))
+            .fold(0.0, f64::max);
+        assert!(
+            longest < (2.0 * W).max(outline_step * 1.01),
+            "{name}: a jump of {longest} mm"
+        );
+        // No two non-adjacent segments cross (the bridges step between rings, never over one).
+        let segs: Vec<(DVec2, DVec2)> = p.windows(2).map(|s| (s[0], s[1])).collect();
+        let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+        for (i, (a, b)) in segs.iter().enumerate() {
+            let key = |q: DVec2| ((q.x / 3.0).floor() as i64, (q.y / 3.0).floor() as i64);
+            let (ka, kb) = (key(a.min(*b)), key(a.max(*b)));
+            for x in ka.0..=kb.0 {
+                for y in ka.1..=kb.1 {
+                    grid.entry((x, y)).or_default().push(i);
+                }
+            }
+        }
+        for ids in grid.values() {
+            for (m, &i) in ids.iter().enumerate() {
+                for &j in &ids[m + 1..] {
+                    let (a, b) = segs[i];
+                    let (c, d) = segs[j];
+                    // Segments meeting at a shared point (a spur's foot) touch, not cross.
+                    let touch = [a, b].iter().any(|p| *p == c || *p == d);
+                    if j > i + 1 && !(i == 0 && j == segs.len() - 1) && !touch {
+                        assert!(
+                            !crate::geometry::segments_intersect(a, b, c, d),
+                            "{name}: segments {i} and {j} cross at {a} {b} / {c} {d}"
+                        );
+                    }
+                }
+            }
+        }
+        let cov = coverage(p, foot, W, W / 8.0);
+        eprintln!(
+            "{name}: {} points, uncovered {:.2} %, doubled {:.2} %",
+            p.len(),
+            cov.uncovered * 100.0,
+            cov.doubled * 100.0
+        );
+        assert!(
+            cov.uncovered < 0.02,
+            "{name}: {:.2} % uncovered",
+            cov.uncovered * 100.0
+        );
+        assert!(
+            cov.doubled < 0.05,
+            "{name}: {:.2} % doubled",
+            cov.doubled * 100.0
+        );
+        fill
+    }
+
+    #[test]
+    fn circle_and_ellipse() {
+        let f = check("circle", &polar(360, |_| 30.0));
+        assert!(f.narrow.is_none());
+        let e: Vec<DVec2> = polar(360, |_| 1.0)
+            .iter()
+            .map(|p| DVec2::new(40.0 * p.x, 22.0 * p.y))
+            .collect();
+        check("ellipse", &e);
+    }
+
+    #[test]
+    fn deep_star() {
+        // Six points, outer radius 50, inner 22 (the star): not scaled copies.
+        let star: Vec<DVec2> = (0..12)
+            .map(|i| {
+                DVec2::from_angle(TAU * i as f64 / 12.0) * if i % 2 == 0 { 50.0 } else { 22.0 }
+            })
+            .collect();
+        let star = crate::geometry::resample_closed(&star, 720);
+        check("star", &star);
+    }
+
+    #[test]
+    fn l_shape_and_kidney() {
+        let l = polygon(
+            &[
+                (0.0, 0.0),
+                (80.0, 0.0),
+                (80.0, 30.0),
+                (30.0, 30.0),
+                (30.0, 70.0),
+                (0.0, 70.0),
+            ],
+            720,
+        );
+        check("L", &l);
+        // A kidney: a circle pushed in on one side (not star-shaped around its x-extremes midpoint).
+        let kidney = polar(720, |a| {
+            30.0 * (1.0 - 0.55 * (-(a - TAU / 4.0).powi(2) / 0.18).exp()) + 8.0 * a.cos().powi(2)
+        });
+        check("kidney", &kidney);
+    }
+
+    #[test]
+    fn a_waist_splits_the_rings_and_both_lobes_are_filled() {
+        // Two discs joined by a neck 6 mm wide: the offsets split into two lobes.
+        let mut pts = Vec::new();
+        for i in 0..720 {
+            let a = TAU * i as f64 / 720.0;
+            let r = 25.0;
+            let (x, y) = (
+                45.0 * a.cos(),
+                r * a.sin() * (0.12 + 0.88 * (1.0 - (-(a.cos() * 3.0).powi(2)).exp())),
+            );
+            pts.push(DVec2::new(x, y));
+        }
+        let tree = ring_tree(&pts, W).unwrap();
+        fn splits(n: &Node) -> bool {
+            n.children.len() >= 2 || n.children.iter().any(splits)
+        }
+        assert!(splits(&tree), "the dumbbell's rings split into two lobes");
+        check("dumbbell", &pts);
+    }
+
+    #[test]
+    fn a_foot_narrower_than_a_bead_is_refused_and_a_thin_arm_is_reported() {
+        let sliver = polygon(&[(0.0, 0.0), (50.0, 0.0), (50.0, 0.8), (0.0, 0.8)], 200);
+        assert_eq!(fill_foot(&sliver, W), Err(FillError::NarrowerThanABead));
+        // A disc with a 0.8 mm wide arm sticking out 15 mm.
+        let arm = polygon(
+            &[
+                (0.0, 0.0),
+                (20.0, 0.0),
+                (20.0, 0.4),
+                (35.0, 0.4),
+                (35.0, 1.2),
+                (20.0, 1.2),
+                (20.0, 20.0),
+                (0.0, 20.0),
+            ],
+            720,
+        );
+        let f = fill_foot(&arm, W).unwrap();
+        let spot = f.narrow.expect("the arm is narrower than a bead");
+        assert!(spot.at.x > 22.0 && spot.at.y < 2.0, "{spot:?}");
+    }
+}
