@@ -30,6 +30,44 @@ fn pipeline(c: &mut Criterion) {
     g.finish();
 }
 
+/// Base fill of a 100 mm foot (issue 13): a six-point star 100 mm across (outer radius 50 mm,
+/// inner 22 mm) sampled at 720 points, 3 mm beads — rings, bridges and corner spurs.
+fn base_fill(c: &mut Criterion) {
+    let star: Vec<DVec2> = (0..12)
+        .map(|i| {
+            DVec2::from_angle(std::f64::consts::TAU * i as f64 / 12.0)
+                * if i % 2 == 0 { 50.0 } else { 22.0 }
+        })
+        .collect();
+    let foot = clayloft_core::geometry::resample_closed(&star, 720);
+    let circle: Vec<DVec2> = (0..720)
+        .map(|i| DVec2::from_angle(std::f64::consts::TAU * i as f64 / 720.0) * 50.0)
+        .collect();
+    let mut g = c.benchmark_group("base_fill");
+    g.sample_size(20);
+    g.bench_function("star_100mm", |b| {
+        b.iter(|| {
+            black_box(
+                clayloft_core::base_fill::fill_foot(&foot, 3.0)
+                    .unwrap()
+                    .path
+                    .len(),
+            )
+        })
+    });
+    g.bench_function("disc_100mm", |b| {
+        b.iter(|| {
+            black_box(
+                clayloft_core::base_fill::fill_foot(&circle, 3.0)
+                    .unwrap()
+                    .path
+                    .len(),
+            )
+        })
+    });
+    g.finish();
+}
+
 /// A 1 M-point helix, written to memory: formatting speed, in bytes per second.
 fn gcode_writing(c: &mut Criterion) {
     let design = parse_design(BIG_DESIGN).unwrap();
@@ -83,5 +121,5 @@ fn gcode_writing(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, pipeline, gcode_writing);
+criterion_group!(benches, pipeline, base_fill, gcode_writing);
 criterion_main!(benches);

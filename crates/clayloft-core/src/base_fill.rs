@@ -1,10 +1,10 @@
 //! Base fill (SPEC §13): one continuous path that covers any flat, simple closed foot with beads
 //! one line width apart — connected contour-parallel offsets.
 //!
-//! **Rings.** The foot's inward offsets by w, 2w, 3w, … (w the line width), each offset from the
-//! foot itself (with `cavalier_contours`, so errors do not pile up and splits, pinches and
-//! vanishing lobes come out right), and one more at (j + ½)·w inside a ring at level j that has
-//! no ring one level in but is still wider than a bead in the middle. They form a tree: a ring's
+//! **Rings.** The foot's inward offsets by w, 2w, 3w, … (w the line width), each the offset by w
+//! of the ring around it kept exactly with its arcs (with `cavalier_contours`, which gets
+//! splits, pinches and vanishing lobes right), and one more at (j + ½)·w inside a ring at level
+//! j where no ring one level in covers its middle. They form a tree: a ring's
 //! children are the next level's rings inside it (an offset splits where the foot has a waist).
 //! The root is the foot itself: the wall's first bead.
 //!
@@ -159,29 +159,45 @@ fn polyline(foot: &[DVec2]) -> Polyline<f64> {
 
 /// The foot's inward offset by `d`: its rings, drawn with straight segments, anticlockwise.
 fn offset(foot: &Polyline<f64>, d: f64) -> Result<Vec<Vec<DVec2>>, FillError> {
+    Ok(offset_exact(foot, d)?
+        .into_iter()
+        .map(|(_, pts)| pts)
+        .collect())
+}
+
+/// [`offset`], each ring also kept exactly (with its arcs) for offsetting further.
+fn offset_exact(
+    foot: &Polyline<f64>,
+    d: f64,
+) -> Result<Vec<(Polyline<f64>, Vec<DVec2>)>, FillError> {
     let loops = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         foot.parallel_offset(d)
             .into_iter()
-            .map(|pl| pl.arcs_to_approx_lines(ARC_TOLERANCE_MM).unwrap_or(pl))
+            .map(|pl| {
+                let flat = pl
+                    .arcs_to_approx_lines(ARC_TOLERANCE_MM)
+                    .unwrap_or(pl.clone());
+                (pl, flat)
+            })
             .collect::<Vec<_>>()
     }))
     .map_err(|_| FillError::Offset)?;
     Ok(loops
         .into_iter()
-        .filter(|pl| pl.is_closed() && pl.vertex_count() >= 3)
-        .map(|pl| {
-            let mut pts: Vec<DVec2> = (0..pl.vertex_count())
+        .filter(|(_, flat)| flat.is_closed() && flat.vertex_count() >= 3)
+        .map(|(pl, flat)| {
+            let mut pts: Vec<DVec2> = (0..flat.vertex_count())
                 .map(|i| {
-                    let v = pl.at(i);
+                    let v = flat.at(i);
                     DVec2::new(v.x, v.y)
                 })
                 .collect();
             if crate::geometry::signed_area(&pts) < 0.0 {
                 pts.reverse();
             }
-            without_spikes(pts)
+            (pl, without_spikes(pts))
         })
-        .filter(|pts| pts.len() >= 3 && crate::geometry::signed_area(pts) > 1e-9)
+        .filter(|(_, pts)| pts.len() >= 3 && crate::geometry::signed_area(pts) > 1e-9)
         .collect())
 }
 
@@ -221,76 +237,59 @@ fn contains(poly: &[DVec2], p: DVec2) -> bool {
     inside
 }
 
-/// The ring tree of a foot (module documentation): levels j·w, and (j + ½)·w in the middle of
-/// rings that end before the next level.
+/// The ring tree of a foot (module documentation): each ring the offset by w of the ring around
+/// it, kept exactly with its arcs (erosion by w after erosion by d is erosion by d + w, and the
+/// offset of an arc is an arc: nothing is lost from level to level), and the offset by w/2
+/// where that middle ring is not covered by a deeper one.
 fn ring_tree(foot: &[DVec2], w: f64) -> Result<Node, FillError> {
-    let pl = polyline(foot);
     let (lo, hi) = foot.iter().fold(
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
     );
     // No ring lies deeper than half the foot's smaller extent: a bound on the levels.
     let max_levels = (((hi - lo).min_element() / 2.0) / w).ceil() as usize + 1;
-    let mut levels: Vec<Vec<Vec<DVec2>>> = Vec::new();
-    for j in 1..=max_levels {
-        let loops = offset(&pl, j as f64 * w)?;
-        if loops.is_empty() {
-            break;
-        }
-        levels.push(loops);
-    }
-    // Each level's rings become children of the ring of the level above that holds them; the
-    // half-level rings go under the rings they lie in when no deeper ring covers them.
-    let mut nodes: Vec<Vec<Node>> = Vec::new();
-    for (j, loops) in levels.iter().enumerate() {
-        let mut level: Vec<Node> = loops
-            .iter()
-            .map(|l| Node {
-                ring: Ring::new(l.clone()),
-                step: w,
-                children: Vec::new(),
-            })
-            .collect();
-        let half = offset(&pl, (j as f64 + 1.5) * w)?;
-        let deeper = levels.get(j + 1);
-        for h in half {
-            let covered = deeper.is_some_and(|d| d.iter().any(|r| contains(&h, r[0])));
-            if covered {
-                continue;
-            }
-            if let Some(parent) = level.iter_mut().find(|n| contains(&n.ring.pts, h[0])) {
-                parent.children.push(Node {
-                    ring: Ring::new(h),
-                    step: 0.5 * w,
-                    children: Vec::new(),
-                });
-            }
-        }
-        nodes.push(level);
-    }
     let mut root = Node {
         ring: Ring::new(foot.to_vec()),
         step: 0.0,
         children: Vec::new(),
     };
-    // Attach bottom-up: level j + 1 into level j, level 1 into the foot.
-    while let Some(level) = nodes.pop() {
-        let parents: Vec<&mut Node> = match nodes.last_mut() {
-            Some(above) => above.iter_mut().collect(),
-            None => vec![&mut root],
-        };
-        let mut parents = parents;
-        for node in level {
-            let p = node.ring.pts[0];
-            let k = parents
-                .iter()
-                .position(|n| contains(&n.ring.pts, p))
-                .unwrap_or(0);
-            parents[k].children.push(node);
-        }
-    }
+    grow(&mut root, &polyline(foot), w, max_levels)?;
     orient(&mut root, true, w);
     Ok(root)
+}
+
+/// Adds the rings one level inside `node` (exactly `exact`), and theirs, `levels` deep.
+fn grow(node: &mut Node, exact: &Polyline<f64>, w: f64, levels: usize) -> Result<(), FillError> {
+    if levels == 0 {
+        return Ok(());
+    }
+    for (inner, ring) in offset_exact(exact, w)? {
+        let mut child = Node {
+            ring: Ring::new(ring),
+            step: w,
+            children: Vec::new(),
+        };
+        grow(&mut child, &inner, w, levels - 1)?;
+        node.children.push(child);
+    }
+    // The middle of a ring still wider than a bead where no deeper ring reaches (not inside the
+    // foot itself: there the outline's own bead covers the first half bead).
+    if node.step > 0.0 {
+        for half in offset(exact, 0.5 * w)? {
+            let covered = node
+                .children
+                .iter()
+                .any(|c| c.step == w && contains(&half, c.ring.pts[0]));
+            if !covered {
+                node.children.push(Node {
+                    ring: Ring::new(half),
+                    step: 0.5 * w,
+                    children: Vec::new(),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Turns the rings so that each runs opposite to its parent (the foot anticlockwise): where two
@@ -435,7 +434,13 @@ fn bridges(node: &Node, start: f64, span: f64, w: f64, late: bool) -> Vec<(Bridg
             if lo < w || hi > span - w || !taken.iter().all(|&(x, y)| hi < x || lo > y) {
                 continue;
             }
-            fits.push((((b.s_out - b.s_in) - want).abs(), b));
+            let misfit = ((b.s_out - b.s_in) - want).abs();
+            fits.push((misfit, b));
+            // Inside, the first close fit will do (each candidate costs two nearest-point
+            // searches round the parent).
+            if !late && misfit <= 0.1 * w {
+                break;
+            }
         }
         let least = fits.iter().map(|f| f.0).fold(f64::INFINITY, f64::min);
         let pick = if late {

@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 
-use crate::align::anchor;
+use crate::align::anchor_for;
 use crate::contour::{Contour, ContourError, DENSE_POINTS};
 use crate::design::{ContourSpec, Design};
 use crate::sample::{correspond, sample_from_anchor};
@@ -43,10 +43,10 @@ pub fn sample_contour(
 ) -> Result<SampledContour, FieldError> {
     let contour = Contour::from_spec_in(spec, DENSE_POINTS.max(4 * samples), base)
         .map_err(|e: ContourError| FieldError::new(field, e.to_string()))?;
-    let offset = center - anchor(&contour);
+    let offset = center - anchor_for(spec, &contour);
     let aligned = contour.translated(offset);
     Ok(SampledContour {
-        samples: sample_from_anchor(&aligned, anchor(&aligned), samples),
+        samples: sample_from_anchor(&aligned, center, samples),
         offset,
     })
 }
