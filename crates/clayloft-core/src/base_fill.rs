@@ -165,11 +165,14 @@ fn offset(foot: &Polyline<f64>, d: f64) -> Result<Vec<Vec<DVec2>>, FillError> {
         .collect())
 }
 
+/// A ring as the offsetting library has it (with arcs) and as the path draws it.
+type ExactRing = (Polyline<f64>, Vec<DVec2>);
+
 /// [`offset`], each ring also kept exactly (with its arcs) for offsetting further.
 fn offset_exact(
     foot: &Polyline<f64>,
     d: f64,
-) -> Result<Vec<(Polyline<f64>, Vec<DVec2>)>, FillError> {
+) -> Result<Vec<ExactRing>, FillError> {
     let loops = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         foot.parallel_offset(d)
             .into_iter()
