@@ -27,6 +27,25 @@ use glam::DVec2;
 /// Largest deviation of the drawn offset rings from their arcs, mm (far below a bead).
 const ARC_TOLERANCE_MM: f64 = 0.01;
 
+/// Ring levels a base may have (the tree is built and walked recursively; a clay foot 1 m
+/// across with 1 mm beads has 500).
+pub const MAX_RING_LEVELS: usize = 1000;
+
+/// At most how many rings deep a foot's fill goes: half its smaller extent over the bead width
+/// (no ring lies deeper), plus one.
+pub fn ring_levels(foot: &[DVec2], w: f64) -> usize {
+    let (lo, hi) = foot.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let levels = ((hi - lo).min_element() / 2.0 / w).ceil();
+    if levels.is_finite() {
+        levels.min(1e9) as usize + 1
+    } else {
+        usize::MAX
+    }
+}
+
 /// Why a foot cannot be filled.
 #[derive(Debug, Clone, PartialEq)]
 pub enum FillError {
@@ -34,6 +53,8 @@ pub enum FillError {
     NarrowerThanABead,
     /// The offset of the outline failed (a foot the offsetting library cannot handle).
     Offset,
+    /// More ring levels than [`MAX_RING_LEVELS`].
+    TooDeep { levels: usize },
 }
 
 /// A place where the foot is narrower than one bead: the beads on either side overlap there.
@@ -169,10 +190,7 @@ fn offset(foot: &Polyline<f64>, d: f64) -> Result<Vec<Vec<DVec2>>, FillError> {
 type ExactRing = (Polyline<f64>, Vec<DVec2>);
 
 /// [`offset`], each ring also kept exactly (with its arcs) for offsetting further.
-fn offset_exact(
-    foot: &Polyline<f64>,
-    d: f64,
-) -> Result<Vec<ExactRing>, FillError> {
+fn offset_exact(foot: &Polyline<f64>, d: f64) -> Result<Vec<ExactRing>, FillError> {
     let loops = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         foot.parallel_offset(d)
             .into_iter()
@@ -245,12 +263,10 @@ fn contains(poly: &[DVec2], p: DVec2) -> bool {
 /// offset of an arc is an arc: nothing is lost from level to level), and the offset by w/2
 /// where that middle ring is not covered by a deeper one.
 fn ring_tree(foot: &[DVec2], w: f64) -> Result<Node, FillError> {
-    let (lo, hi) = foot.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    // No ring lies deeper than half the foot's smaller extent: a bound on the levels.
-    let max_levels = (((hi - lo).min_element() / 2.0) / w).ceil() as usize + 1;
+    let max_levels = ring_levels(foot, w);
+    if max_levels > MAX_RING_LEVELS {
+        return Err(FillError::TooDeep { levels: max_levels });
+    }
     let mut root = Node {
         ring: Ring::new(foot.to_vec()),
         step: 0.0,

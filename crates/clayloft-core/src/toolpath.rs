@@ -119,6 +119,21 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     //    (`base_fill`), from and to the section's point 0; alternate layers run it backwards so
     //    each starts where the one below ended, and the last ends where the wall starts.
     let feet: Vec<Vec<DVec2>> = (1..=base).map(|k| sections[k].xy()).collect();
+    // Bounded before any ring is made: each of up to `levels` rings has at most about as many
+    // points as the foot.
+    if let Some(foot) = feet.last() {
+        let levels = crate::base_fill::ring_levels(foot, p.line_width) as u128;
+        let estimate = base as u128 * levels * n as u128;
+        if estimate + wall_points > MAX_PATH_POINTS as u128 {
+            return Err(FieldError::new(
+                "shape.base_layers",
+                format!(
+                    "{base} base layers of up to {levels} rings of {n} points and the wall make up to {} points, more than the {MAX_PATH_POINTS} a path may have (a wider bead, fewer samples or fewer base layers)",
+                    estimate + wall_points
+                ),
+            ));
+        }
+    }
     let fills = crate::base_fill::fill_feet(&feet, p.line_width).map_err(|e| {
         FieldError::new(
             "shape.base_layers",
@@ -126,6 +141,10 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
                 crate::base_fill::FillError::NarrowerThanABead => format!(
                     "the foot is nowhere as wide as one bead (printer.line_width = {} mm), so no base can be laid; use base_layers = 0 or a wider foot",
                     p.line_width
+                ),
+                crate::base_fill::FillError::TooDeep { levels } => format!(
+                    "the base would be {levels} rings deep, more than the {} a base may have (a wider bead, printer.line_width)",
+                    crate::base_fill::MAX_RING_LEVELS
                 ),
                 crate::base_fill::FillError::Offset => {
                     "the foot's outline could not be offset for the base fill; use base_layers = 0"
