@@ -39,6 +39,7 @@ pub mod pipeline;
 pub mod profile;
 pub mod report;
 pub mod sample;
+pub mod save;
 pub mod section;
 pub mod session;
 pub mod shape;

@@ -119,7 +119,8 @@ pub fn open_design(path: &Path) -> Result<Design, String> {
         .map_err(|e| e.to_string())
 }
 
-/// Saves a design as TOML, atomically, and checks that it loads back identical. Saved in another
+/// Saves a design as TOML, atomically, and checks that it loads back identical; over an
+/// existing design file, its comments and layout are kept ([`clayloft_core::save`]). Saved in another
 /// folder, its picture and drawing paths are rewritten to lead from there to the same files
 /// ([`Design::moved_to`]); returns the design as saved.
 pub fn save_design(design: &Design, path: &Path) -> Result<Design, String> {
@@ -128,7 +129,16 @@ pub fn save_design(design: &Design, path: &Path) -> Result<Design, String> {
         _ => Path::new("."),
     };
     let design = design.moved_to(dir);
-    let text = design.to_toml();
+    // Over an existing design file its text is edited in place: comments and layout stay.
+    let text = match std::fs::read_to_string(path) {
+        Ok(previous) => {
+            let meant = clayloft_core::load::load_design_text(path, previous.clone())
+                .ok()
+                .map(|l| l.design);
+            clayloft_core::save::toml_keeping(&design, &previous, meant.as_ref())
+        }
+        Err(_) => design.to_toml(),
+    };
     write_atomically(path, |w| w.write_all(text.as_bytes())).map_err(|e| e.to_string())?;
     match open_design(path) {
         Ok(back) if back == design => Ok(design),
@@ -417,6 +427,35 @@ mod tests {
                 clayloft_core::run(&back).unwrap(),
             );
             assert_eq!(a.toolpath.points, b.toolpath.points, "{}", p.display());
+        }
+    }
+
+    #[test]
+    fn saving_over_an_annotated_design_keeps_its_comments() {
+        let dir = tempfile::tempdir().unwrap();
+        let pictures = dir.path().join("contours");
+        std::fs::create_dir_all(&pictures).unwrap();
+        for f in std::fs::read_dir(design_path().parent().unwrap().join("../contours")).unwrap() {
+            let f = f.unwrap().path();
+            std::fs::copy(&f, pictures.join(f.file_name().unwrap())).unwrap();
+        }
+        let designs = dir.path().join("designs");
+        std::fs::create_dir_all(&designs).unwrap();
+        for entry in std::fs::read_dir(design_path().parent().unwrap()).unwrap() {
+            let p = entry.unwrap().path();
+            let copy = designs.join(p.file_name().unwrap());
+            std::fs::copy(&p, &copy).unwrap();
+            let original = std::fs::read_to_string(&copy).unwrap();
+            let mut d = open_design(&copy).unwrap();
+            d.shape.height += 5.0;
+            d.printer.layer_height = 0.8;
+            save_design(&d, &copy).unwrap();
+            let saved = std::fs::read_to_string(&copy).unwrap();
+            for line in original.lines().filter(|l| l.trim_start().starts_with('#')) {
+                assert!(saved.contains(line), "{}: lost {line:?}", p.display());
+            }
+            assert!(saved.contains("layer_height = 0.8"), "{}", p.display());
+            assert_eq!(open_design(&copy).unwrap().shape.height, d.shape.height);
         }
     }
 
