@@ -114,14 +114,14 @@ fn draw_panels(
             }
             ui.separator();
             if ui
-                .add_enabled(history.can_undo(), egui::Button::new("↶ Undo"))
+                .add_enabled(history.can_undo(), egui::Button::new("⟲ Undo"))
                 .on_hover_text("Ctrl+Z")
                 .clicked()
             {
                 history_cmd.write(HistoryCommand::Undo);
             }
             if ui
-                .add_enabled(history.can_redo(), egui::Button::new("↷ Redo"))
+                .add_enabled(history.can_redo(), egui::Button::new("⟳ Redo"))
                 .on_hover_text("Ctrl+Shift+Z")
                 .clicked()
             {
@@ -173,7 +173,7 @@ fn draw_panels(
                 }
             }
             if let Some(e) = &status.error {
-                ui.colored_label(egui::Color32::from_rgb(255, 90, 90), format!("⚠ {e}"));
+                ui.colored_label(egui::Color32::from_rgb(255, 90, 90), format!("error: {e}"));
             }
             if let Some(m) = &file_status.message {
                 let c = if file_status.is_error {
@@ -249,7 +249,7 @@ fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
         let label = if replay.playing {
             "⏸ pause"
         } else {
-            "▶ play"
+            "⏵ play"
         };
         if ui.button(label).clicked() {
             replay.active = true;
@@ -283,7 +283,7 @@ fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
     if let Some(e) = path.flag_now() {
         ui.colored_label(
             egui::Color32::from_rgb(255, 80, 80),
-            format!("⚠ {} at point {} ({:.1})", e.what, e.line, e.value),
+            format!("{} at point {} ({:.1})", e.what, e.line, e.value),
         );
     }
     if path.events.is_empty() {

@@ -221,7 +221,7 @@ fn draw_printer_window(
             });
             let running = panel.job.is_some();
             ui.horizontal(|ui| {
-                if ui.add_enabled(!running && !panel.port.is_empty(), egui::Button::new("▶ Print design")).clicked()
+                if ui.add_enabled(!running && !panel.port.is_empty(), egui::Button::new("⏵ Print design")).clicked()
                     && let Some(doc) = &doc
                 {
                     let started = engine
