@@ -252,6 +252,11 @@ pub struct Printer {
     /// G-code after the path; `None` = the dialect's.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub end_gcode: Option<String>,
+    /// G-code a printer host sends when a print is cancelled, in place of the rest of the job
+    /// (stop extruding, lift clear of the part, park; placeholders as in `end_gcode`); `None` =
+    /// the end G-code, which does exactly that.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cancel_gcode: Option<String>,
     /// Header comments that printer hosts read (time, clay used, layers) and layer messages.
     pub host_metadata: bool,
     /// `M73` progress (percent and minutes left) through the path.
@@ -307,6 +312,7 @@ impl Default for Printer {
             junction_deviation: 0.013,
             start_gcode: None,
             end_gcode: None,
+            cancel_gcode: None,
             host_metadata: true,
             progress: true,
             thumbnail: true,

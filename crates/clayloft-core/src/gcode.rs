@@ -264,6 +264,25 @@ pub fn program(design: &Design, job: &PrintJob) -> Result<Program, GcodeWriteErr
     })
 }
 
+/// What a printer host sends when this job is cancelled, in place of the rest of it:
+/// `printer.cancel_gcode`, or else the end G-code (stop extruding, lift clear of the rim, park),
+/// filled with the job's values (the park height clears the whole vessel).
+pub fn cancel_gcode(design: &Design, job: &PrintJob) -> Result<String, GcodeWriteError> {
+    let p = &design.printer;
+    let values = template_values(design, job, &summarize(design, job));
+    let (field, template) = match p.cancel_gcode.as_deref() {
+        Some(t) => ("printer.cancel_gcode", t),
+        None => (
+            "printer.end_gcode",
+            p.end_gcode
+                .as_deref()
+                .unwrap_or(crate::templates::default_end(p)),
+        ),
+    };
+    crate::templates::fill(template, &values)
+        .map_err(|error| GcodeWriteError::Template { field, error })
+}
+
 /// Records `lines` text lines, each at path point `point`, when an index is kept.
 #[inline]
 fn mark(index: &mut Option<&mut Vec<u32>>, lines: usize, point: usize) {
@@ -797,6 +816,26 @@ mod tests {
             assert_eq!(moves, job.toolpath.points.len() - 1);
             assert_eq!(last as usize, job.toolpath.points.len() - 1);
         }
+    }
+
+    #[test]
+    fn the_cancel_sequence_lifts_clear_of_the_vessel_and_parks() {
+        let (d, j) = job("");
+        let text = cancel_gcode(&d, &j).unwrap();
+        let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with(';')).collect();
+        // No extrusion; the lift clears the rim (10 mm tall vessel) before any XY move.
+        assert!(lines.iter().all(|l| !l.contains(" E")), "{text}");
+        let lift = lines.iter().position(|l| l.starts_with("G0 Z")).unwrap();
+        let park = lines.iter().position(|l| l.starts_with("G0 X")).unwrap();
+        assert!(lift < park, "{text}");
+        let z: f64 = lines[lift][4..].split(' ').next().unwrap().parse().unwrap();
+        assert!(z > 10.0, "{z}");
+        let (d, j) = job("[printer]\ncancel_gcode = \"M104 S0\\nG91\\nG0 Z{park_z}\\n\"\n");
+        assert!(
+            cancel_gcode(&d, &j)
+                .unwrap()
+                .starts_with("M104 S0\nG91\nG0 Z")
+        );
     }
 
     #[test]

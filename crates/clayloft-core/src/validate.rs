@@ -71,6 +71,7 @@ pub fn validate_printer(p: &Printer) -> Check {
     for (field, template) in [
         ("printer.start_gcode", &p.start_gcode),
         ("printer.end_gcode", &p.end_gcode),
+        ("printer.cancel_gcode", &p.cancel_gcode),
     ] {
         if let Some(t) = template {
             crate::templates::check(t).map_err(|e| FieldError::new(field, e.to_string()))?;

@@ -100,6 +100,11 @@ pub struct Sender {
     seen_busy: bool,
     last_heard: Instant,
     state: State,
+    /// Cancelling: the job's lines after `next_cmd` were replaced by the cancel sequence; the
+    /// job ends `Cancelled` once it is acknowledged. Holds the line the job was cancelled after.
+    cancelled_after: Option<usize>,
+    /// The job's length before a cancel sequence replaced its end.
+    job_lines: Option<usize>,
     out: VecDeque<Vec<u8>>,
     events: VecDeque<Event>,
 }
@@ -123,6 +128,8 @@ impl Sender {
             seen_busy: false,
             last_heard: now,
             state: State::Connecting,
+            cancelled_after: None,
+            job_lines: None,
             out: VecDeque::new(),
             events: VecDeque::new(),
         };
@@ -214,10 +221,13 @@ impl Sender {
                 self.next_cmd += 1;
                 self.send_numbered(n, &cmd);
             }
-            State::Printing => {
-                self.state = State::Finished;
-                self.events.push_back(Event::Finished);
-            }
+            State::Printing => match self.cancelled_after {
+                Some(done) => self.end_cancelled(done),
+                None => {
+                    self.state = State::Finished;
+                    self.events.push_back(Event::Finished);
+                }
+            },
             _ => {}
         }
     }
@@ -413,13 +423,47 @@ impl Sender {
     /// Stops the job after the line in flight; the printer keeps what it has.
     pub fn cancel(&mut self) {
         if !self.is_over() {
-            self.state = State::Cancelled;
-            self.events.push_back(Event::Failed(format!(
-                "cancelled after line {} of {}",
-                self.done(),
-                self.cmds.len()
-            )));
+            let done = self.done();
+            self.end_cancelled(done);
         }
+    }
+
+    /// Cancels the job the way hosts do: the job's lines not yet sent are replaced by `sequence`
+    /// (stop extruding, lift clear of the part, park; numbered and checked like the job), and
+    /// the job ends `Cancelled` once the printer has acknowledged it. A paused job is resumed
+    /// to send it. An empty or malformed sequence cancels at once, as [`Sender::cancel`].
+    pub fn cancel_with(&mut self, sequence: Vec<String>) {
+        if self.is_over() || self.cancelled_after.is_some() {
+            return;
+        }
+        if sequence.is_empty() || check_job(&sequence).is_err() {
+            return self.cancel();
+        }
+        self.cancelled_after = Some(self.next_cmd);
+        self.job_lines = Some(self.cmds.len());
+        self.cmds.truncate(self.next_cmd);
+        self.cmds.extend(sequence);
+        if self.state == State::Paused {
+            self.resume();
+        }
+    }
+
+    fn end_cancelled(&mut self, done: usize) {
+        self.state = State::Cancelled;
+        let total = self.job_len();
+        let tail = if self.cancelled_after.is_some() {
+            "; the cancel sequence ran"
+        } else {
+            ""
+        };
+        self.events.push_back(Event::Failed(format!(
+            "cancelled after line {done} of {total}{tail}"
+        )));
+    }
+
+    /// Lines of the job as it was given (before a cancel sequence replaced its end).
+    fn job_len(&self) -> usize {
+        self.job_lines.unwrap_or(self.cmds.len())
     }
 
     /// `M112` at once (bare: Marlin's emergency parser reads it even with a full queue) and stop.
@@ -588,6 +632,37 @@ mod tests {
         assert!(s.is_over());
         let (mut s, _) = start(4);
         s.cancel();
+        assert_eq!(s.state(), &State::Cancelled);
+    }
+
+    #[test]
+    fn cancel_sends_the_cancel_sequence_in_place_of_the_rest() {
+        let (mut s, t) = start(10);
+        assert_eq!(out(&mut s), vec![line(1, "G1 X0")]);
+        s.receive("ok", t);
+        assert_eq!(out(&mut s), vec![line(2, "G1 X1")]);
+        // Paused, then cancelled: the sequence goes out after the line in flight.
+        s.pause();
+        s.cancel_with(vec!["G91".into(), "G1 Z10 F600".into(), "G90".into()]);
+        s.receive("ok", t);
+        let mut sent = out(&mut s);
+        for _ in 0..3 {
+            s.receive("ok", t);
+            sent.extend(out(&mut s));
+        }
+        assert_eq!(
+            sent,
+            vec![line(3, "G91"), line(4, "G1 Z10 F600"), line(5, "G90")]
+        );
+        assert_eq!(s.state(), &State::Cancelled);
+        let said: Vec<Event> = s.events().collect();
+        assert!(
+            said.iter().any(|e| matches!(e, Event::Failed(m) if m == "cancelled after line 2 of 10; the cancel sequence ran")),
+            "{said:?}"
+        );
+        // A malformed sequence cancels at once.
+        let (mut s, _) = start(4);
+        s.cancel_with(vec![format!("G1 X{}", "9".repeat(200))]);
         assert_eq!(s.state(), &State::Cancelled);
     }
 

@@ -54,6 +54,8 @@ pub struct PrinterPanel {
     pub done: usize,
     pub total: usize,
     pub started: Option<Instant>,
+    /// The job's planned printing time (the core's motion planner), s.
+    pub planned_s: f64,
     pub temperatures: Option<Temperatures>,
     pub messages: VecDeque<String>,
     pub status: Option<(String, bool)>,
@@ -88,6 +90,10 @@ pub fn start_job(
         .zip(&program.point_of_line)
         .filter_map(|(line, &point)| strip(line).map(|c| (c.to_string(), point as usize)))
         .unzip();
+    // Cancel sends this in place of the rest of the job: stop extruding, lift clear, park.
+    let cancel = clayloft_serial::line::commands(
+        &clayloft_core::gcode::cancel_gcode(design, job).map_err(|e| e.to_string())?,
+    );
     let mut sender =
         Sender::new(cmds, SenderConfig::default(), Instant::now()).map_err(|e| e.to_string())?;
     let mut link = open_port(port, baud)?;
@@ -106,7 +112,7 @@ pub fn start_job(
                     match c {
                         Control::Pause => s.pause(),
                         Control::Resume => s.resume(),
-                        Control::Cancel => s.cancel(),
+                        Control::Cancel => s.cancel_with(cancel.clone()),
                         Control::EmergencyStop => s.emergency_stop(),
                     }
                 }
@@ -224,11 +230,16 @@ fn draw_printer_window(
                 if ui.add_enabled(!running && !panel.port.is_empty(), egui::Button::new("⏵ Print design")).clicked()
                     && let Some(doc) = &doc
                 {
+                    let planned = engine
+                        .current_job(&doc.design)
+                        .map(|job| clayloft_core::gcode::summarize(&doc.design, &job).estimated_time_s)
+                        .unwrap_or(0.0);
                     let started = engine
                         .current_job(&doc.design)
                         .and_then(|job| start_job(&doc.design, &job, &panel.port.clone(), panel.baud));
                     match started {
                         Ok(job) => {
+                            panel.planned_s = planned;
                             panel.job = Some(job);
                             panel.done = 0;
                             panel.started = Some(Instant::now());
@@ -237,11 +248,14 @@ fn draw_printer_window(
                         Err(e) => panel.status = Some((e, true)),
                     }
                 }
+                let port = panel.port.clone();
+                let mut now_paused = None;
                 if let Some(job) = &mut panel.job {
                     let label = if job.paused { "resume" } else { "pause" };
                     if ui.button(label).clicked() {
                         let _ = job.control.send(if job.paused { Control::Resume } else { Control::Pause });
                         job.paused = !job.paused;
+                        now_paused = Some(job.paused);
                     }
                     if ui.button("cancel").clicked() {
                         let _ = job.control.send(Control::Cancel);
@@ -250,15 +264,22 @@ fn draw_printer_window(
                         let _ = job.control.send(Control::EmergencyStop);
                     }
                 }
+                if let Some(paused) = now_paused {
+                    let what = if paused { "paused" } else { "printing" };
+                    panel.status = Some((format!("{what} on {port}"), false));
+                }
             });
             if panel.total > 0 {
                 let f = panel.done as f32 / panel.total as f32;
-                let eta = panel.started.filter(|_| f > 0.0).map(|t| t.elapsed().as_secs_f32() * (1.0 - f) / f);
+                // From the planned time, not the clock: a pause does not make it grow, and there is
+                // none once the job has ended.
+                let left = (panel.job.is_some() && panel.planned_s > 0.0)
+                    .then(|| panel.planned_s * (1.0 - f64::from(f)));
                 ui.add(egui::ProgressBar::new(f).text(format!(
                     "{}/{} lines{}",
                     panel.done,
                     panel.total,
-                    eta.map(|e| format!(", {:.0} s left", e)).unwrap_or_default()
+                    left.map(|e| format!(", about {} left", clayloft_core::gcode::format_duration(e))).unwrap_or_default()
                 )));
             }
             if let Some(t) = panel.temperatures {
@@ -335,5 +356,62 @@ mod tests {
                 assert_eq!(p, k, "{cmd}");
             }
         }
+    }
+
+    #[test]
+    fn cancel_lifts_and_parks_on_the_fake_printer() {
+        use clayloft_serial::fake::{FakePrinter, Faults};
+        use clayloft_serial::link::serve_fake;
+        use serialport::{SerialPort, TTYPort};
+        let (mut master, slave) = TTYPort::pair().unwrap();
+        master
+            .set_timeout(std::time::Duration::from_millis(5))
+            .unwrap();
+        let name = slave.name().unwrap();
+        drop(slave);
+        let fake = std::thread::spawn(move || {
+            serve_fake(
+                &mut master as &mut dyn SerialPort,
+                FakePrinter::new(Faults::default()),
+                |_| false,
+            )
+        });
+        let design = clayloft_core::load::parse_design(
+            "version = 1\n[shape]\nheight = 30.0\nsamples = 60\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
+        )
+        .unwrap();
+        let print = clayloft_core::run(&design).unwrap();
+        let job = start_job(&design, &print, &name, 115_200).unwrap();
+        let rx = job.events.lock().unwrap();
+        let mut cancelled = false;
+        let end = loop {
+            match rx
+                .recv_timeout(std::time::Duration::from_secs(20))
+                .expect("no hang")
+            {
+                LinkEvent::Ended(r) => break r,
+                LinkEvent::Event(Event::Progress { done, .. }) if done > 200 && !cancelled => {
+                    job.control.send(Control::Cancel).unwrap();
+                    cancelled = true;
+                }
+                LinkEvent::Event(_) => {}
+            }
+        };
+        assert_eq!(end, Err("cancelled".into()));
+        drop(rx);
+        drop(job);
+        let printer = fake.join().unwrap();
+        let expected = clayloft_serial::line::commands(
+            &clayloft_core::gcode::cancel_gcode(&design, &print).unwrap(),
+        );
+        // The printer ran part of the path, then the cancel sequence, and nothing else.
+        assert!(printer.log.len() < 1000, "{}", printer.log.len());
+        assert_eq!(
+            printer.log[printer.log.len() - expected.len()..],
+            expected[..]
+        );
+        let lift = expected.iter().find(|c| c.starts_with("G0 Z")).unwrap();
+        let z: f64 = lift[4..].split(' ').next().unwrap().parse().unwrap();
+        assert!(z > 30.0, "{lift}");
     }
 }
