@@ -671,14 +671,7 @@ mod tests {
 
     const W: f64 = 1.2;
 
-    fn polar(n: usize, r: impl Fn(f64) -> f64) -> Vec<DVec2> {
-        (0..n)
-            .map(|i| {
-                let a = TAU * i as f64 / n as f64;
-                DVec2::from_angle(a) * r(a)
-            })
-            .collect()
-    }
+    use crate::contour::polar;
 
     /// The closed polygon with corners `c`, resampled at `n` points (point 0 at the first).
     fn polygon(c: &[(f64, f64)], n: usize) -> Vec<DVec2> {

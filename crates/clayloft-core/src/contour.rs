@@ -153,7 +153,8 @@ impl Contour {
     }
 }
 
-fn polar(n: usize, r: impl Fn(f64) -> f64) -> Vec<DVec2> {
+/// `n` points of the polar curve `r(θ)`, θ from 0 in equal steps.
+pub(crate) fn polar(n: usize, r: impl Fn(f64) -> f64) -> Vec<DVec2> {
     (0..n)
         .map(|i| {
             let th = TAU * i as f64 / n as f64;

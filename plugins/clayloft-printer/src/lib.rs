@@ -303,8 +303,12 @@ fn draw_printer_window(
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_job_streams_to_a_fake_printer_on_its_thread() {
+    /// The fake printer on one end of a pseudo-terminal pair: the other end's name, and the
+    /// thread serving it (its log once the job has ended).
+    fn fake_printer() -> (
+        String,
+        std::thread::JoinHandle<clayloft_serial::fake::FakePrinter>,
+    ) {
         use clayloft_serial::fake::{FakePrinter, Faults};
         use clayloft_serial::link::serve_fake;
         use serialport::{SerialPort, TTYPort};
@@ -321,6 +325,12 @@ mod tests {
                 |_| false,
             )
         });
+        (name, fake)
+    }
+
+    #[test]
+    fn a_job_streams_to_a_fake_printer_on_its_thread() {
+        let (name, fake) = fake_printer();
         let design = clayloft_core::load::parse_design(
             "version = 1\n[shape]\nheight = 5.0\nsamples = 24\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
         )
@@ -360,22 +370,7 @@ mod tests {
 
     #[test]
     fn cancel_lifts_and_parks_on_the_fake_printer() {
-        use clayloft_serial::fake::{FakePrinter, Faults};
-        use clayloft_serial::link::serve_fake;
-        use serialport::{SerialPort, TTYPort};
-        let (mut master, slave) = TTYPort::pair().unwrap();
-        master
-            .set_timeout(std::time::Duration::from_millis(5))
-            .unwrap();
-        let name = slave.name().unwrap();
-        drop(slave);
-        let fake = std::thread::spawn(move || {
-            serve_fake(
-                &mut master as &mut dyn SerialPort,
-                FakePrinter::new(Faults::default()),
-                |_| false,
-            )
-        });
+        let (name, fake) = fake_printer();
         let design = clayloft_core::load::parse_design(
             "version = 1\n[shape]\nheight = 30.0\nsamples = 60\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
         )
