@@ -55,6 +55,7 @@ pub fn print(file: &Path, port: &str, baud: u32, timeout_s: f64) -> Result<ExitC
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut last_message = String::new();
+    let mut recovered = 0;
     run_job(
         link.as_mut(),
         &mut sender,
@@ -66,6 +67,7 @@ pub fn print(file: &Path, port: &str, baud: u32, timeout_s: f64) -> Result<ExitC
                 }
             }
             Event::Message(m) => last_message = m.clone(),
+            Event::Recovered { count, .. } => recovered = *count,
             Event::PrinterError(m) => {
                 // Shown above the bar, kept in the terminal: the job goes on.
                 bar.println(format!("printer error (the job goes on): {m}"));
@@ -76,6 +78,9 @@ pub fn print(file: &Path, port: &str, baud: u32, timeout_s: f64) -> Result<ExitC
         |_| {},
     );
     bar.finish_and_clear();
+    if recovered > 0 {
+        println!("{recovered} transmission errors caught by the printer, each line resent");
+    }
     match sender.state() {
         State::Finished => {
             println!("printed {} lines to {port}", sender.total());

@@ -93,6 +93,14 @@ fn hundred_thousand_lines_with_five_percent_faults_arrive_exactly_once_in_order(
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // The recovered errors are one summary line, not a line each.
+    let said = String::from_utf8_lossy(&out.stdout);
+    let summary: Vec<&str> = said
+        .lines()
+        .filter(|l| l.contains("transmission errors caught by the printer, each line resent"))
+        .collect();
+    assert_eq!(summary.len(), 1, "{said}");
+    assert!(!said.contains("checksum"), "{said}");
     let fake_out = wait_bounded(fake, Duration::from_secs(20));
     let err = String::from_utf8_lossy(&fake_out.stderr);
     assert!(err.contains("faults 5.0 %"), "{err}");

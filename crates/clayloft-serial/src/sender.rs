@@ -56,6 +56,12 @@ pub enum Event {
     Temperatures(Temperatures),
     /// A message from the printer worth showing.
     Message(String),
+    /// A transmission error the printer caught (a checksum or line-number mismatch) and that a
+    /// resend recovers: `count` of them so far in this job, and the printer's words for the last.
+    Recovered {
+        count: u64,
+        last: String,
+    },
     /// An error the printer reported that does not stop the job (a refused command, an unknown
     /// `Error:`): shown prominently; the job goes on with the printer's next `ok`.
     PrinterError(String),
@@ -105,6 +111,8 @@ pub struct Sender {
     cancelled_after: Option<usize>,
     /// The job's length before a cancel sequence replaced its end.
     job_lines: Option<usize>,
+    /// Transmission errors the printer caught and a resend recovered.
+    recovered: u64,
     out: VecDeque<Vec<u8>>,
     events: VecDeque<Event>,
 }
@@ -130,6 +138,7 @@ impl Sender {
             state: State::Connecting,
             cancelled_after: None,
             job_lines: None,
+            recovered: 0,
             out: VecDeque::new(),
             events: VecDeque::new(),
         };
@@ -314,7 +323,13 @@ impl Sender {
                     ));
                 }
             }
-            Reply::ErrorAwaitResend(m) => self.events.push_back(Event::Message(m)),
+            Reply::ErrorAwaitResend(m) => {
+                self.recovered += 1;
+                self.events.push_back(Event::Recovered {
+                    count: self.recovered,
+                    last: m,
+                });
+            }
             Reply::Fatal(m) => self.fail(format!("the printer stopped: {m}")),
             Reply::Temperatures(t) => self.events.push_back(Event::Temperatures(t)),
             Reply::Message(m) => self.events.push_back(Event::Message(m)),
@@ -778,6 +793,26 @@ mod tests {
         let (mut s, t) = start(4);
         s.receive("//action:disconnect", t);
         assert!(matches!(s.state(), State::Failed(m) if m.contains("disconnect")));
+    }
+
+    #[test]
+    fn recovered_transmission_errors_are_counted_not_listed() {
+        let (mut s, t) = start(5);
+        out(&mut s);
+        for _ in 0..3 {
+            s.receive("Error:checksum mismatch, Last Line: 0", t);
+            s.receive("Resend: 1", t);
+            s.receive("ok", t);
+        }
+        let said: Vec<Event> = s.events().collect();
+        assert!(
+            said.iter().all(|e| !matches!(e, Event::Message(_))),
+            "{said:?}"
+        );
+        assert!(said.contains(&Event::Recovered {
+            count: 3,
+            last: "Error:checksum mismatch, Last Line: 0".into()
+        }));
     }
 
     #[test]

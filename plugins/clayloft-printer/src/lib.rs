@@ -56,6 +56,8 @@ pub struct PrinterPanel {
     pub started: Option<Instant>,
     /// The job's planned printing time (the core's motion planner), s.
     pub planned_s: f64,
+    /// Transmission errors the printer caught and resends recovered, this job.
+    pub recovered: u64,
     pub temperatures: Option<Temperatures>,
     pub messages: VecDeque<String>,
     pub status: Option<(String, bool)>,
@@ -167,6 +169,7 @@ fn pump_link_events(
                     panel.messages.pop_front();
                 }
             }
+            LinkEvent::Event(Event::Recovered { count, .. }) => panel.recovered = count,
             LinkEvent::Event(Event::PrinterError(m)) => {
                 panel
                     .messages
@@ -240,6 +243,7 @@ fn draw_printer_window(
                     match started {
                         Ok(job) => {
                             panel.planned_s = planned;
+                            panel.recovered = 0;
                             panel.job = Some(job);
                             panel.done = 0;
                             panel.started = Some(Instant::now());
@@ -281,6 +285,13 @@ fn draw_printer_window(
                     panel.total,
                     left.map(|e| format!(", about {} left", clayloft_core::gcode::format_duration(e))).unwrap_or_default()
                 )));
+            }
+            if panel.recovered > 0 {
+                ui.label(format!(
+                    "{} lines resent (transmission errors the printer caught; recovered)",
+                    panel.recovered
+                ))
+                .on_hover_text("The printer found a line garbled on the way (its checksum or number did not match) and asked for it again: normal on long USB cables, harmless once resent.");
             }
             if let Some(t) = panel.temperatures {
                 let show = |v: Option<(f64, f64)>| v.map(|(a, b)| format!("{a:.1}/{b:.0} °C")).unwrap_or("–".into());
