@@ -16,7 +16,8 @@
 //!    (`ShapeModel::section`), in parallel on the machine's cores;
 //! 4. the surface: overhang correction, texture, metrics, fit on the machine
 //!    (`pipeline::finish_surface`);
-//! 5. the toolpath: the one continuous spiral (`toolpath::build_toolpath`).
+//! 5. the base fill of the feet (`toolpath::base_fills`), kept while the feet do not change;
+//! 6. the toolpath: the one continuous spiral (`toolpath::build_toolpath_on`).
 //!
 //! The batch [`crate::run`] is a fresh session's first update.
 
@@ -32,7 +33,7 @@ use crate::pipeline::{PrintJob, Surface, finish_surface};
 use crate::report::Finding;
 use crate::section::Section;
 use crate::shape::ShapeModel;
-use crate::toolpath::{Toolpath, build_toolpath};
+use crate::toolpath::{Toolpath, build_toolpath_on};
 use crate::validate::{FieldError, validate};
 
 /// The two contours, in the order of [`Session::contour`].
@@ -139,10 +140,21 @@ pub struct TextureKey {
     pub sections: usize,
 }
 
+/// Inputs of the base fill: the feet it fills and the bead width (and the wall's length, which
+/// bounds the path).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BaseKey {
+    pub feet: Vec<Vec<DVec2>>,
+    pub line_width: f64,
+    pub wall: (usize, usize),
+}
+
 /// Inputs of the spiral toolpath.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ToolpathKey {
     pub surface: u64,
+    /// The base fill (by revision).
+    pub base: u64,
     pub base_layers: usize,
     pub line_width: f64,
     pub min_layer_height: f64,
@@ -185,6 +197,7 @@ pub struct Session {
     /// The texture's displacements on the section grid (no shape input: kept while shaping).
     texture: Stage<TextureKey, Vec<Vec<f64>>>,
     surface: Stage<SurfaceKey, Arc<Surface>>,
+    base: Stage<BaseKey, Vec<crate::base_fill::BaseFill>>,
     toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
     /// The design and job of the last successful update.
     design: Option<Design>,
@@ -361,8 +374,22 @@ impl Session {
         })?;
 
         // 5. Toolpath.
+        let surface = self
+            .surface
+            .get()
+            .cloned()
+            .expect("the surface stage ran above");
+        // The base fill is kept while the feet are the same (an edit higher up the wall).
+        let key = BaseKey {
+            feet: crate::toolpath::base_feet(design, &surface),
+            line_width: p.line_width,
+            wall: (surface.layers, surface.sections[0].points.len()),
+        };
+        self.base
+            .refresh(key, || crate::toolpath::base_fills(design, &surface))?;
         let key = ToolpathKey {
             surface: self.surface.revision,
+            base: self.base.revision,
             base_layers: design.shape.base_layers,
             line_width: p.line_width,
             min_layer_height: p.min_layer_height,
@@ -371,10 +398,9 @@ impl Session {
             print_speed: p.print_speed,
             flow_ramp: (p.flow_ramp_start, p.flow_ramp_end),
         };
-        let surface = self.surface.get().cloned();
+        let fills = self.base.get().expect("the base stage ran above");
         done.toolpath = self.toolpath.refresh(key, || {
-            let surface = surface.expect("the surface stage ran above");
-            build_toolpath(design, &surface).map(Arc::new)
+            build_toolpath_on(design, &surface, fills).map(Arc::new)
         })?;
         Ok(done)
     }

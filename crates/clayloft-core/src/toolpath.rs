@@ -92,35 +92,41 @@ impl PathBuilder {
 }
 
 /// Builds the single continuous spiral path of a surface.
-// Index loops: sample i addresses several parallel arrays (sections, fractions, z below).
-#[allow(clippy::needless_range_loop)]
 pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, FieldError> {
+    let fills = base_fills(design, surface)?;
+    build_toolpath_on(design, surface, &fills)
+}
+
+/// The sections the base layers fill (1 ..= base, in XY): what [`base_fills`] reads.
+pub fn base_feet(design: &Design, surface: &Surface) -> Vec<Vec<DVec2>> {
+    let base = design
+        .shape
+        .base_layers
+        .min(surface.layers.saturating_sub(1));
+    (1..=base).map(|k| surface.sections[k].xy()).collect()
+}
+
+/// Points the wall of a surface makes at most.
+fn wall_points(surface: &Surface) -> u128 {
+    let n = surface.sections[0].points.len();
+    (surface.layers as u128 + 2) * (n as u128 + 1)
+}
+
+/// The base layers' fills (`base_fill`), each from and to its section's point 0, bounded
+/// before any ring is made; the session keeps them while the feet do not change.
+pub fn base_fills(
+    design: &Design,
+    surface: &Surface,
+) -> Result<Vec<crate::base_fill::BaseFill>, FieldError> {
     let p = &design.printer;
-    let sections = &surface.sections;
-    let layers = surface.layers;
-    let h = surface.layer_pitch;
-    let a = p.min_layer_height;
-    let base = design.shape.base_layers.min(layers.saturating_sub(1));
-    let n = sections[0].points.len();
-    let mut layer_starts = Vec::with_capacity(layers + base + 2);
-    let wall_points = (layers as u128 + 2) * (n as u128 + 1);
-    let too_many = |points: u128| {
-        FieldError::new(
-            "shape.base_layers",
-            format!(
-                "{base} base layers and the wall make {points} points, more than the {MAX_PATH_POINTS} a path may have (a wider bead, fewer samples or fewer base layers)"
-            ),
-        )
-    };
+    let feet = base_feet(design, surface);
+    let (base, n) = (feet.len(), surface.sections[0].points.len());
+    let wall_points = wall_points(surface);
     if wall_points > MAX_PATH_POINTS as u128 {
-        return Err(too_many(wall_points));
+        // The wall alone is too long: [`build_toolpath_on`] says so.
+        return Ok(Vec::new());
     }
-    // 1. Base: layers 1 ..= base, each the connected ring fill of its own section
-    //    (`base_fill`), from and to the section's point 0; alternate layers run it backwards so
-    //    each starts where the one below ended, and the last ends where the wall starts.
-    let feet: Vec<Vec<DVec2>> = (1..=base).map(|k| sections[k].xy()).collect();
-    // Bounded before any ring is made: each of up to `levels` rings has at most about as many
-    // points as the foot.
+    // Each of up to `levels` rings has at most about as many points as the foot.
     if let Some(foot) = feet.last() {
         let levels = crate::base_fill::ring_levels(foot, p.line_width) as u128;
         let estimate = base as u128 * levels * n as u128;
@@ -134,7 +140,7 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
             ));
         }
     }
-    let fills = crate::base_fill::fill_feet(&feet, p.line_width).map_err(|e| {
+    crate::base_fill::fill_feet(&feet, p.line_width).map_err(|e| {
         FieldError::new(
             "shape.base_layers",
             match e {
@@ -152,7 +158,37 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
                 }
             },
         )
-    })?;
+    })
+}
+
+/// [`build_toolpath`] with the base fills already made ([`base_fills`] of this surface).
+// Index loops: sample i addresses several parallel arrays (sections, fractions, z below).
+#[allow(clippy::needless_range_loop)]
+pub fn build_toolpath_on(
+    design: &Design,
+    surface: &Surface,
+    fills: &[crate::base_fill::BaseFill],
+) -> Result<Toolpath, FieldError> {
+    let p = &design.printer;
+    let sections = &surface.sections;
+    let layers = surface.layers;
+    let h = surface.layer_pitch;
+    let a = p.min_layer_height;
+    let base = fills.len();
+    let n = sections[0].points.len();
+    let mut layer_starts = Vec::with_capacity(layers + base + 2);
+    let wall_points = wall_points(surface);
+    let too_many = |points: u128| {
+        FieldError::new(
+            "shape.base_layers",
+            format!(
+                "{base} base layers and the wall make {points} points, more than the {MAX_PATH_POINTS} a path may have (a wider bead, fewer samples or fewer base layers)"
+            ),
+        )
+    };
+    if wall_points > MAX_PATH_POINTS as u128 {
+        return Err(too_many(wall_points));
+    }
     let mut findings = Vec::new();
     if let Some(spot) = fills.first().and_then(|f| f.narrow) {
         findings.push(Finding {
