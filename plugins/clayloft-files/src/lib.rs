@@ -100,6 +100,7 @@ impl Plugin for FilesPlugin {
         }
         app.init_resource::<FileStatus>()
             .init_resource::<Exports>()
+            .init_resource::<SavedDesign>()
             .add_message::<FileCommand>()
             .add_systems(
                 Update,
@@ -108,7 +109,44 @@ impl Plugin for FilesPlugin {
                     .in_set(ModelSystems::Edit),
             )
             .add_systems(Update, poll_exports)
-            .add_systems(Update, write_autosave.after(ModelSystems::Recompute));
+            .add_systems(Update, write_autosave.after(ModelSystems::Recompute))
+            .add_systems(Update, show_unsaved_in_title.after(ModelSystems::Edit));
+    }
+}
+
+/// The design as its file holds it (as last opened or saved); `None` until first read. The
+/// window title marks the design unsaved while it differs.
+#[derive(Resource, Debug, Default)]
+pub struct SavedDesign(pub Option<Design>);
+
+/// The window title: `Clayloft — NAME (FILE)`, with `•` before the name while there are
+/// changes the file does not have. The title is written only when it changes.
+fn show_unsaved_in_title(
+    doc: Option<Res<DesignDoc>>,
+    mut saved: ResMut<SavedDesign>,
+    mut windows: Query<&mut Window, With<bevy::window::PrimaryWindow>>,
+) {
+    let Some(doc) = doc else { return };
+    if saved.0.is_none() {
+        // Read once from the file: edits restored from an autosave count as unsaved.
+        let from_file = doc.path.as_deref().and_then(|p| open_design(p).ok());
+        saved.bypass_change_detection().0 = Some(from_file.unwrap_or_else(|| doc.design.clone()));
+    }
+    let unsaved = saved.0.as_ref() != Some(&doc.design) || doc.path.is_none();
+    let file = doc
+        .path
+        .as_deref()
+        .and_then(|p| p.file_name())
+        .map_or("no file".to_string(), |f| f.to_string_lossy().into_owned());
+    let title = format!(
+        "Clayloft — {}{} ({file})",
+        if unsaved { "• " } else { "" },
+        doc.design.name
+    );
+    for mut window in &mut windows {
+        if window.title != title {
+            window.title = title.clone();
+        }
     }
 }
 
@@ -272,6 +310,7 @@ fn run_file_commands(
     mut autosave: ResMut<Autosave>,
     engine: Res<Engine>,
     mut exports: ResMut<Exports>,
+    mut saved: ResMut<SavedDesign>,
 ) {
     let Some(mut doc) = doc else { return };
     for c in commands.read() {
@@ -280,6 +319,7 @@ fn run_file_commands(
                 Ok(d) => {
                     doc.design = d;
                     doc.path = Some(path.clone());
+                    saved.0 = Some(doc.design.clone());
                     autosave.written = Some(doc.design.clone());
                     status.ok(format!("opened {}", path.display()));
                 }
@@ -291,8 +331,9 @@ fn run_file_commands(
                     continue;
                 };
                 match save_design(&doc.design, &path) {
-                    Ok(saved) => {
-                        doc.design = saved;
+                    Ok(design) => {
+                        doc.design = design;
+                        saved.0 = Some(doc.design.clone());
                         let _ = std::fs::remove_file(autosave.path_for(doc.path.as_deref()));
                         autosave.written = Some(doc.design.clone());
                         autosave.pending_since = None;
@@ -473,6 +514,44 @@ mod tests {
         app.insert_resource(a);
         app.add_plugins((clayloft_model::ModelPlugin, FilesPlugin));
         app
+    }
+
+    #[test]
+    fn the_title_marks_unsaved_changes_until_saved() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("vase.toml");
+        std::fs::copy(design_path(), &file).unwrap();
+        std::fs::create_dir_all(dir.path().join("auto")).unwrap();
+        let mut app = app(&dir.path().join("auto"));
+        let design = open_design(&file).unwrap();
+        app.insert_resource(DesignDoc {
+            design: design.clone(),
+            path: Some(file.clone()),
+        });
+        app.world_mut()
+            .spawn((Window::default(), bevy::window::PrimaryWindow));
+        let title = |app: &mut App| {
+            let mut q = app
+                .world_mut()
+                .query_filtered::<&Window, With<bevy::window::PrimaryWindow>>();
+            q.single(app.world()).unwrap().title.clone()
+        };
+        app.update();
+        assert_eq!(
+            title(&mut app),
+            format!("Clayloft — {} (vase.toml)", design.name)
+        );
+        app.world_mut()
+            .resource_mut::<DesignDoc>()
+            .design
+            .shape
+            .height += 10.0;
+        app.update();
+        assert!(title(&mut app).contains("— • "), "{}", title(&mut app));
+        app.world_mut().write_message(FileCommand::Save(None));
+        app.update();
+        app.update();
+        assert!(!title(&mut app).contains('•'), "{}", title(&mut app));
     }
 
     #[test]
