@@ -163,6 +163,28 @@ pub fn outward_normal_at(points: &[DVec2], i: usize) -> DVec2 {
     DVec2::new(d.y, -d.x).normalize_or_zero()
 }
 
+/// The smallest and largest x and y of a set of points (their bounding box's corners).
+pub fn bounds(points: &[DVec2]) -> (DVec2, DVec2) {
+    points.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
+
+/// True when `p` lies inside the closed polyline (even–odd rule: a ray from p crosses it an
+/// odd number of times).
+pub fn contains_point(poly: &[DVec2], p: DVec2) -> bool {
+    let n = poly.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
 /// Distance from `p` to segment `a–b`, and the parameter `f ∈ [0, 1]` of the closest point.
 pub fn point_segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
     let ab = b - a;

@@ -343,27 +343,13 @@ fn run_file_commands(
                     Err(e) => status.err(e),
                 }
             }
-            FileCommand::ExportGcode(path) => {
+            FileCommand::ExportGcode(path) | FileCommand::ExportStl(path) => {
+                let write = match c {
+                    FileCommand::ExportGcode(_) => export_gcode,
+                    _ => export_stl,
+                };
                 let job = current_job(&engine, &doc.design, path);
-                start_export(
-                    &mut exports,
-                    &mut status,
-                    path,
-                    job,
-                    &doc.design,
-                    export_gcode,
-                );
-            }
-            FileCommand::ExportStl(path) => {
-                let job = current_job(&engine, &doc.design, path);
-                start_export(
-                    &mut exports,
-                    &mut status,
-                    path,
-                    job,
-                    &doc.design,
-                    export_stl,
-                );
+                start_export(&mut exports, &mut status, path, job, &doc.design, write);
             }
         }
     }
