@@ -142,6 +142,7 @@ impl PluginGroup for ClayloftPlugins {
     fn build(self) -> PluginGroupBuilder {
         PluginGroupBuilder::start::<Self>()
             .add(ThirdPartyPlugins)
+            .add(clayloft_ui::UiPlugin)
             .add(ModelPlugin)
             .add(clayloft_view::ViewPlugin)
             .add(clayloft_edit::EditPlugin)

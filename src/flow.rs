@@ -25,6 +25,10 @@ pub struct FlowOptions {
     /// Reynolds number of the cavity case.
     #[arg(long, default_value_t = 100.0)]
     pub re: f64,
+    /// Bingham number of the cavity case: a Bingham plastic in creeping flow instead of a
+    /// Newtonian fluid at --re (the viscoplastic benchmark; 0 = Newtonian Stokes flow).
+    #[arg(long, value_name = "BN")]
+    pub bingham: Option<f64>,
     /// Screw speed, revolutions per minute.
     #[arg(long, default_value_t = 45.0)]
     pub rpm: f64,
@@ -73,6 +77,8 @@ struct Setup {
     to_ms: f64,
     /// For the channel: the analytic profile in lattice units, and the plug half-width in mm.
     channel: Option<Channel>,
+    /// The yield stress in lattice units (0 without one): cells below it are unyielded.
+    yield_stress: f64,
 }
 
 struct Channel {
@@ -189,12 +195,41 @@ pub fn flow(o: FlowOptions) -> Result<ExitCode, Failure> {
             );
         }
     }
+    if setup.yield_stress > 0.0 {
+        let unyielded = analysis::unyielded_fraction(&solver.shear_stresses(), setup.yield_stress);
+        println!(
+            "unyielded (shear stress below the yield stress): {:.1} % of the cells",
+            100.0 * unyielded
+        );
+    }
     println!("wrote {} results to {}", o.case, o.out.display());
     Ok(ExitCode::SUCCESS)
 }
 
-/// The lid-driven cavity at `--re`, normalised (the Ghia et al. benchmark).
+/// The lid-driven cavity at `--re`, normalised (the Ghia et al. benchmark), or with `--bingham`
+/// a Bingham plastic in creeping flow.
 fn cavity(o: &FlowOptions) -> Result<Setup, Failure> {
+    if let Some(bn) = o.bingham {
+        if !(bn.is_finite() && (0.0..=1000.0).contains(&bn)) {
+            return Err(Failure(format!("--bingham {bn}: must lie in 0 … 1000")));
+        }
+        let (solver, tau0) = clayloft_flow::cavity::bingham(o.cells, bn, 1.0 / 6.0);
+        println!(
+            "Bingham lid-driven cavity, Bn = {bn}, creeping flow (lattice Re = {}), {} × {} lattice",
+            clayloft_flow::groove::LATTICE_REYNOLDS,
+            o.cells,
+            o.cells
+        );
+        let lid = solver.bounds.lid_u;
+        return Ok(Setup {
+            solver,
+            scale_lu: lid,
+            cell_mm: None,
+            to_ms: 1.0 / lid,
+            channel: None,
+            yield_stress: tau0,
+        });
+    }
     if !(0.01..=5000.0).contains(&o.re) {
         return Err(Failure(format!("--re {}: must lie in 0.01 … 5000", o.re)));
     }
@@ -221,6 +256,7 @@ fn cavity(o: &FlowOptions) -> Result<Setup, Failure> {
         cell_mm: None,
         to_ms: 1.0 / lid,
         channel: None,
+        yield_stress: 0.0,
     })
 }
 
@@ -275,24 +311,37 @@ fn groove(o: &FlowOptions, m: Material) -> Result<Setup, Failure> {
     };
     let l = g.to_lattice(o.cells, 1.0);
     println!(
-        "groove {} × {} mm, screw Ø {} mm at {} rpm: barrel wall {:.4} m/s",
-        o.width_mm, o.depth_mm, o.diameter_mm, o.rpm, l.lid_speed
+        "groove {} × {} mm, screw Ø {} mm at {} rpm: barrel wall {:.4} m/s, shear rate U/H = {:.2}/s",
+        o.width_mm,
+        o.depth_mm,
+        o.diameter_mm,
+        o.rpm,
+        l.lid_speed,
+        g.shear_rate()
     );
     println!(
-        "Reynolds number Re = U·H/ν(U/H) = {:.3e} (Stokes flow); lattice {} × {}, Δx = {:.1} µm, Δt = {:.3e} s, wall {:.3e} lattice units",
+        "Reynolds number Re = U·H/ν(U/H) = {:.3e} (creeping flow: solved at lattice Re = {}); Bingham number τ₀/(K·(U/H)ⁿ) = {:.2}; lattice {} × {}, Δx = {:.1} µm",
         l.reynolds,
+        clayloft_flow::groove::LATTICE_REYNOLDS,
+        l.bingham,
         l.nx,
         l.ny,
         l.dx * 1e6,
-        l.dt,
-        l.lid_u
     );
     Ok(Setup {
-        solver: Solver::new(l.nx, l.ny, l.fluid, Boundaries::cavity(l.lid_u), 0.51, 10.0),
+        solver: Solver::new(
+            l.nx,
+            l.ny,
+            l.fluid,
+            Boundaries::cavity(l.lid_u),
+            clayloft_flow::cavity::TAU_MIN,
+            clayloft_flow::cavity::TAU_MAX,
+        ),
         scale_lu: l.lid_u,
         cell_mm: Some(l.dx * 1e3),
-        to_ms: l.dx / l.dt,
+        to_ms: l.lid_speed / l.lid_u,
         channel: None,
+        yield_stress: l.yield_stress(),
     })
 }
 
@@ -367,6 +416,7 @@ fn channel(o: &FlowOptions, m: Material) -> Result<Setup, Failure> {
             plug_half_mm: y0_phys * 1e3,
             gap_mm: o.depth_mm,
         }),
+        yield_stress: tau0,
     })
 }
 

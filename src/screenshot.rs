@@ -72,7 +72,7 @@ fn drive_screenshot(
         return;
     }
     if vessel.is_empty() {
-        if let Some(e) = &status.error {
+        if let Some(e) = status.error() {
             eprintln!("error: {e}");
             exit.write(AppExit::from_code(2));
         }

@@ -65,6 +65,46 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64, why: &str) -> Check {
     Ok(())
 }
 
+/// Most problems [`validate_all`] lists.
+pub const MAX_REPORTED: usize = 12;
+
+/// Every problem of a design, not only the first [`validate`] stops at: each refused field is
+/// reported and then set back to its default (removed from the design's TOML form) to look for
+/// the next, up to [`MAX_REPORTED`]. A problem in a list entry (`control.vertical[1]…`), or in a
+/// field whose default is refused too, ends the search there.
+pub fn validate_all(d: &Design) -> Vec<FieldError> {
+    let mut found = Vec::new();
+    let mut current = d.clone();
+    while found.len() < MAX_REPORTED {
+        let Err(e) = validate(&current) else { break };
+        let next = without_field(&current, &e.field);
+        found.push(e);
+        match next {
+            Some(n) => current = n,
+            None => break,
+        }
+    }
+    found
+}
+
+/// `d` with the field at dotted `path` back at its default; `None` where that cannot be done or
+/// changes nothing.
+fn without_field(d: &Design, path: &str) -> Option<Design> {
+    if path.contains('[') {
+        return None;
+    }
+    let mut value = toml::Value::try_from(d).ok()?;
+    let mut keys: Vec<&str> = path.split('.').collect();
+    let last = keys.pop()?;
+    let mut table = value.as_table_mut()?;
+    for k in keys {
+        table = table.get_mut(k)?.as_table_mut()?;
+    }
+    table.remove(last)?;
+    let next: Design = value.try_into().ok()?;
+    (next != *d).then_some(next)
+}
+
 /// Checks the printer fields alone (a printer profile is checked with this before it is merged
 /// into a design).
 pub fn validate_printer(p: &Printer) -> Check {
@@ -420,5 +460,36 @@ fn contour(f: &str, c: &ContourSpec) -> Check {
                 "mm across the longer side",
             )
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn design(extra: &str) -> Design {
+        let text = format!(
+            "version = 1\n[shape]\nheight = 100.0\nlower = {{ type = \"circle\", radius = 40.0 }}\nupper = {{ type = \"circle\", radius = 50.0 }}\n{extra}"
+        );
+        toml::from_str(&text).expect("a design")
+    }
+
+    #[test]
+    fn every_problem_is_listed_not_only_the_first() {
+        assert!(validate_all(&design("")).is_empty());
+        let d = design("[printer]\nprint_speed = -3.0\nlayer_height = 80.0\n");
+        let all = validate_all(&d);
+        let fields: Vec<&str> = all.iter().map(|e| e.field.as_str()).collect();
+        assert!(fields.contains(&"printer.print_speed"), "{all:?}");
+        assert!(fields.contains(&"printer.layer_height"), "{all:?}");
+        // The first is the one `validate` reports.
+        assert_eq!(Err(all[0].clone()), validate(&d));
+        // A bad list entry ends the search: still reported.
+        let mut bad = design("");
+        bad.shape.samples = 0;
+        bad.shape.height = -5.0;
+        let all = validate_all(&bad);
+        assert!(all.iter().any(|e| e.field == "shape.height"), "{all:?}");
+        assert!(all.len() <= MAX_REPORTED);
     }
 }

@@ -15,10 +15,13 @@
 //! - [`solver`]: the lattice, pull streaming, half-way bounce-back walls, a moving lid (Ladd),
 //!   periodic channels with a body force (Guo), time steps on one or several threads
 //!   ([`parallel`]: bands of rows and a spinning barrier);
+//! - [`cavity`]: the lid-driven cavity benchmarks, Newtonian and Bingham;
 //! - [`groove`]: the screw groove in physical units and its conversion to the lattice;
-//! - [`analysis`]: vortex centre, dead zones, streamlines, the analytic channel profile.
+//! - [`analysis`]: vortex centre, dead zones, unyielded share, streamlines, the analytic channel
+//!   profile.
 
 pub mod analysis;
+pub mod cavity;
 pub mod collision;
 pub mod fastmath;
 pub mod groove;

@@ -1,6 +1,11 @@
 //! Handle entities made visible and draggable: a small sphere per [`EditHandle`], picked with the
 //! mouse or a finger; dragging moves it in the plane its value lives in and writes the value into
 //! the design.
+//!
+//! Handles drawn on the same spot (at 0° the rim radius and the ends of the control lines meet)
+//! form a stack: a click on it picks one, the next click the next one ([`next_pick`]), and a drag
+//! starting there moves the picked one. A drag that cannot move the handle (across its free
+//! directions, [`freedom`]) says why in [`DragHint`].
 
 use std::collections::HashMap;
 
@@ -10,7 +15,9 @@ use bevy::picking::mesh_picking::{MeshPickingCamera, MeshPickingPlugin, MeshPick
 use bevy::prelude::*;
 use bevy_panorbit_camera::PanOrbitCamera;
 use clayloft_model::coords::{from_world, to_world};
-use clayloft_model::handles::{HandleFrame, HandleRole, handle_frame, set_handle};
+use clayloft_model::handles::{
+    HandleFrame, HandleRole, describe, freedom, handle_frame, handle_roles, next_pick, set_handle,
+};
 use clayloft_model::*;
 
 use crate::history::{EditInProgress, PanelInUse};
@@ -33,7 +40,28 @@ pub struct DragState {
     pub plane_normal: Vec3,
     /// Grab point minus handle centre (world).
     pub grab: Vec3,
+    /// How far the pointer has moved since the drag started, logical pixels (a press that
+    /// barely moves is a click).
+    pub moved_px: f32,
+    /// Whether the drag changed the design yet.
+    pub changed: bool,
+    /// The selection before the press (a press that stays a click picks from it).
+    pub selection_before: Option<HandleRole>,
 }
+
+/// Why the last drag did not move its handle, or which handle a click picked: shown in the
+/// status line; replaced by the next pick or drag.
+#[derive(Resource, Debug, Clone, Default, PartialEq)]
+pub struct DragHint(pub Option<String>);
+
+/// Screen distance, logical pixels, within which handles count as drawn on the same spot.
+pub const STACK_PX: f32 = 10.0;
+
+/// Pointer travel, logical pixels, past which a press is a drag and no longer a click.
+const CLICK_SLOP_PX: f32 = 4.0;
+
+/// Pointer travel, logical pixels, past which a drag that changed nothing is told why.
+const LOCKED_PX: f32 = 25.0;
 
 /// Radius of a handle sphere, mm.
 pub const HANDLE_RADIUS: f32 = 2.6;
@@ -61,6 +89,7 @@ pub fn picking_setup(app: &mut App) {
 pub(crate) fn plugin(app: &mut App) {
     app.init_resource::<Selection>()
         .init_resource::<ActiveDrag>()
+        .init_resource::<DragHint>()
         .add_systems(Startup, make_handle_look)
         .add_systems(
             Update,
@@ -222,60 +251,118 @@ pub fn contour_offsets(
     contours.iter().map(|(r, s)| (*r, s.offset)).collect()
 }
 
+/// The handles drawn on the same spot as `entity`'s handle (itself included), in the design's
+/// handle order: within [`STACK_PX`] of it on screen, or — where the camera cannot project, as
+/// in a headless app — whose spheres overlap in space.
+fn stack_at(
+    entity: Entity,
+    handles: &Query<(Entity, &EditHandle, &GlobalTransform)>,
+    cams: &Query<(&Camera, &GlobalTransform), With<Camera3d>>,
+    design: &clayloft_core::Design,
+) -> Vec<HandleRole> {
+    let Ok((_, _, hit)) = handles.get(entity) else {
+        return vec![];
+    };
+    let on_screen = |g: &GlobalTransform| {
+        let (cam, eye) = cams.iter().next()?;
+        cam.world_to_viewport(eye, g.translation()).ok()
+    };
+    let same_spot = |g: &GlobalTransform| match (on_screen(hit), on_screen(g)) {
+        (Some(a), Some(b)) => a.distance(b) <= STACK_PX,
+        _ => hit.translation().distance(g.translation()) <= 2.0 * HANDLE_RADIUS,
+    };
+    let near: Vec<HandleRole> = handles
+        .iter()
+        .filter(|(_, _, g)| same_spot(g))
+        .map(|(_, h, _)| h.0)
+        .collect();
+    handle_roles(design)
+        .into_iter()
+        .filter(|r| near.contains(r))
+        .collect()
+}
+
+#[allow(clippy::too_many_arguments)]
 fn start_drag(
     ev: On<Pointer<DragStart>>,
-    handles: Query<(&EditHandle, &Transform)>,
+    handles: Query<(Entity, &EditHandle, &GlobalTransform)>,
     doc: Option<Res<DesignDoc>>,
     engine: Res<Engine>,
     contours: Query<(&ContourRole, &ContourSamples)>,
-    cams: Query<&GlobalTransform, With<Camera3d>>,
+    cams: Query<(&Camera, &GlobalTransform), With<Camera3d>>,
     mut drag: ResMut<ActiveDrag>,
     mut selection: ResMut<Selection>,
     mut busy: ResMut<EditInProgress>,
 ) {
-    let (Ok((handle, t)), Some(doc)) = (handles.get(ev.entity), doc) else {
+    let (Ok((_, hit, _)), Some(doc)) = (handles.get(ev.entity), doc) else {
         return;
     };
     let Some(model) = engine.0.model() else {
         return;
     };
-    let Some(frame) = handle_frame(handle.0, &doc.design, model, &contour_offsets(&contours))
+    // On a stack, the handle picked by clicking is the one dragged.
+    let stack = stack_at(ev.entity, &handles, &cams, &doc.design);
+    let role = selection.0.filter(|s| stack.contains(s)).unwrap_or(hit.0);
+    let Some(translation) = handles
+        .iter()
+        .find(|(_, h, _)| h.0 == role)
+        .map(|(_, _, g)| g.translation())
     else {
+        return;
+    };
+    let Some(frame) = handle_frame(role, &doc.design, model, &contour_offsets(&contours)) else {
         return;
     };
     let eye = cams
         .iter()
         .next()
-        .map_or(Vec3::NEG_Z, |g| g.forward().as_vec3());
-    let normal = drag_plane_normal(handle.0, &frame, eye);
-    let grab = ev.hit.position.map_or(Vec3::ZERO, |p| p - t.translation);
+        .map_or(Vec3::NEG_Z, |(_, g)| g.forward().as_vec3());
+    let normal = drag_plane_normal(role, &frame, eye);
+    let grab = ev.hit.position.map_or(Vec3::ZERO, |p| p - translation);
     drag.0 = Some(DragState {
-        role: handle.0,
+        role,
         frame,
-        plane_point: t.translation,
+        plane_point: translation,
         plane_normal: normal,
         grab,
+        moved_px: 0.0,
+        changed: false,
+        selection_before: selection.0,
     });
-    selection.0 = Some(handle.0);
+    selection.set_if_neq(Selection(Some(role)));
     busy.0 = true;
 }
 
 fn drag_handle(
     ev: On<Pointer<Drag>>,
-    drag: Res<ActiveDrag>,
+    mut drag: ResMut<ActiveDrag>,
     cams: Query<(&Camera, &GlobalTransform), With<Camera3d>>,
     doc: Option<ResMut<DesignDoc>>,
+    mut hint: ResMut<DragHint>,
 ) {
-    let (Some(state), Some(mut doc)) = (drag.0, doc) else {
+    let (Some(state), Some(mut doc)) = (drag.0.as_mut(), doc) else {
         return;
     };
+    state.moved_px = state.moved_px.max(ev.distance.length());
     let Some((o, d)) = pointer_ray(&cams, ev.pointer_location.position) else {
         return;
     };
     let Some(t) = ray_plane(o, d, state.plane_point + state.grab, state.plane_normal) else {
         return;
     };
-    move_handle_to(&mut doc, state.role, &state.frame, o + d * t - state.grab);
+    state.changed |= move_handle_to(&mut doc, state.role, &state.frame, o + d * t - state.grab);
+    if !state.changed && state.moved_px > LOCKED_PX {
+        hint.set_if_neq(DragHint(Some(locked_hint(state.role, &doc.design))));
+    }
+}
+
+/// What a drag that cannot move its handle says: which handle, and why that way is fixed.
+pub fn locked_hint(role: HandleRole, design: &clayloft_core::Design) -> String {
+    format!(
+        "{} — {}",
+        describe(role, design),
+        freedom(role, design).locked
+    )
 }
 
 /// The world ray under the pointer: origin and unit direction.
@@ -289,17 +376,19 @@ pub(crate) fn pointer_ray(
 }
 
 /// Writes the value that puts the handle at `target` (world) into the design — only if it
-/// changes, so change detection stays quiet while the pointer rests.
+/// changes, so change detection stays quiet while the pointer rests. Returns whether it did.
 pub(crate) fn move_handle_to(
-    doc: &mut DesignDoc,
+    doc: &mut ResMut<DesignDoc>,
     role: HandleRole,
     frame: &HandleFrame,
     target: Vec3,
-) {
+) -> bool {
     let mut edited = doc.design.clone();
-    if set_handle(role, &mut edited, frame, from_world(target)) {
+    let changed = set_handle(role, &mut edited, frame, from_world(target));
+    if changed {
         doc.design = edited;
     }
+    changed
 }
 
 fn end_drag(
@@ -311,12 +400,36 @@ fn end_drag(
     busy.0 = false;
 }
 
+/// A click picks the handle under the pointer, or on a stack the next one ([`next_pick`]); a
+/// press that turned into a drag is not a click.
 fn select_on_click(
     ev: On<Pointer<Click>>,
-    handles: Query<&EditHandle>,
+    handles: Query<(Entity, &EditHandle, &GlobalTransform)>,
+    cams: Query<(&Camera, &GlobalTransform), With<Camera3d>>,
+    doc: Option<Res<DesignDoc>>,
+    drag: Res<ActiveDrag>,
     mut selection: ResMut<Selection>,
+    mut hint: ResMut<DragHint>,
 ) {
-    if let Ok(h) = handles.get(ev.entity) {
-        selection.0 = Some(h.0);
+    if drag.0.is_some_and(|d| d.moved_px > CLICK_SLOP_PX) {
+        return;
     }
+    // A press that moved a little started a drag, which selected already: pick from before it.
+    let current = drag.0.map_or(selection.0, |d| d.selection_before);
+    let (Ok((_, h, _)), Some(doc)) = (handles.get(ev.entity), doc) else {
+        return;
+    };
+    let stack = stack_at(ev.entity, &handles, &cams, &doc.design);
+    let picked = next_pick(&stack, h.0, current);
+    selection.set_if_neq(Selection(Some(picked)));
+    let mut said = describe(picked, &doc.design);
+    if stack.len() > 1 {
+        let at = stack.iter().position(|r| *r == picked).unwrap_or(0);
+        said += &format!(
+            " ({} of {} handles here: click again for the next)",
+            at + 1,
+            stack.len()
+        );
+    }
+    hint.set_if_neq(DragHint(Some(said)));
 }

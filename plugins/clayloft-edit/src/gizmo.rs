@@ -1,12 +1,14 @@
-//! The move gizmo: three axis arrows (design x red, y green, z blue) and a plane square (the bed
-//! plane) on the selected handle. Dragging an arrow moves the handle only along that axis;
-//! dragging the square moves it parallel to the bed. Built on picking like the handles (the
-//! transform-gizmo crate needs a newer compiler than ours).
+//! The move gizmo on the selected handle: an arrow along each direction the handle can move in
+//! ([`freedom`]: a radius along itself, a control-line point up and down and in and out, a contour
+//! point across the bed plane — upright arrows blue, the others red and green) and, for points
+//! free in the bed plane, a square that moves them parallel to the bed. Dragging an arrow moves
+//! the handle only along it. Built on picking like the handles (the transform-gizmo crate needs
+//! a newer compiler than ours).
 
 use bevy::picking::Pickable;
 use bevy::prelude::*;
 use clayloft_model::coords::to_world;
-use clayloft_model::handles::{HandleFrame, HandleRole, handle_frame};
+use clayloft_model::handles::{Direction, HandleFrame, HandleRole, freedom, handle_frame};
 use clayloft_model::*;
 
 use crate::drag::{Selection, contour_offsets, move_handle_to, pointer_ray};
@@ -19,6 +21,18 @@ const ARROW: f32 = 22.0;
 /// The gizmo's root entity, placed on the selected handle.
 #[derive(Component, Debug, Clone, Copy)]
 pub struct MoveGizmo;
+
+/// Arrow `0`, `1` or `2` of the gizmo: the handle's free directions in order.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GizmoArrow(pub usize);
+
+/// The arrows' colours: upright, first and second bed-plane direction.
+#[derive(Resource)]
+struct GizmoLook {
+    upright: Handle<StandardMaterial>,
+    first: Handle<StandardMaterial>,
+    second: Handle<StandardMaterial>,
+}
 
 /// One grabbable part of the gizmo.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
@@ -63,21 +77,12 @@ fn spawn_gizmo(
             ..default()
         })
     };
-    let parts = [
-        (
-            GizmoPart::Axis(to_world(bevy::math::DVec3::X)),
-            mat(Color::srgb(0.95, 0.2, 0.2)),
-        ),
-        (
-            GizmoPart::Axis(to_world(bevy::math::DVec3::Y)),
-            mat(Color::srgb(0.2, 0.9, 0.3)),
-        ),
-        (
-            GizmoPart::Axis(to_world(bevy::math::DVec3::Z)),
-            mat(Color::srgb(0.25, 0.45, 1.0)),
-        ),
-        (GizmoPart::BedPlane, mat(Color::srgba(0.95, 0.9, 0.3, 0.8))),
-    ];
+    let look = GizmoLook {
+        first: mat(Color::srgb(0.95, 0.2, 0.2)),
+        second: mat(Color::srgb(0.2, 0.9, 0.3)),
+        upright: mat(Color::srgb(0.25, 0.45, 1.0)),
+    };
+    let plane = mat(Color::srgba(0.95, 0.9, 0.3, 0.8));
     let shaft = meshes.add(Cuboid::new(1.2, 1.2, ARROW));
     let square = meshes.add(Cuboid::new(7.0, 0.6, 7.0));
     commands
@@ -88,45 +93,124 @@ fn spawn_gizmo(
             Name::new("move gizmo"),
         ))
         .with_children(|root| {
-            for (part, material) in parts {
-                let (mesh, transform) = match part {
-                    GizmoPart::Axis(a) => (
-                        shaft.clone(),
-                        Transform::from_translation(a * (ARROW / 2.0 + 3.0))
-                            .looking_to(a, if a.y.abs() > 0.9 { Vec3::X } else { Vec3::Y }),
-                    ),
-                    GizmoPart::BedPlane => (square.clone(), Transform::from_xyz(8.0, 0.0, -8.0)),
-                };
+            for i in 0..3 {
                 root.spawn((
-                    part,
-                    Mesh3d(mesh),
-                    MeshMaterial3d(material),
-                    transform,
+                    GizmoArrow(i),
+                    GizmoPart::Axis(Vec3::Y),
+                    Mesh3d(shaft.clone()),
+                    MeshMaterial3d(look.upright.clone()),
+                    Transform::default(),
+                    Visibility::Hidden,
                     Pickable::default(),
                 ))
                 .observe(start_gizmo_drag)
                 .observe(gizmo_drag)
                 .observe(end_gizmo_drag);
             }
+            root.spawn((
+                GizmoPart::BedPlane,
+                Mesh3d(square),
+                MeshMaterial3d(plane),
+                Transform::from_xyz(8.0, 0.0, -8.0),
+                Visibility::Hidden,
+                Pickable::default(),
+            ))
+            .observe(start_gizmo_drag)
+            .observe(gizmo_drag)
+            .observe(end_gizmo_drag);
         });
+    commands.insert_resource(look);
 }
 
+/// The arrow along world direction `a`, its shaft starting a little off the handle.
+fn arrow_transform(a: Vec3) -> Transform {
+    Transform::from_translation(a * (ARROW / 2.0 + 3.0))
+        .looking_to(a, if a.y.abs() > 0.9 { Vec3::X } else { Vec3::Y })
+}
+
+/// Puts the gizmo on the selected handle with an arrow per direction it moves in.
+#[allow(clippy::type_complexity)]
 fn follow_selection(
     selection: Res<Selection>,
-    handles: Query<(&EditHandle, &Transform), Without<MoveGizmo>>,
+    doc: Option<Res<DesignDoc>>,
+    engine: Res<Engine>,
+    look: Option<Res<GizmoLook>>,
+    contours: Query<(&ContourRole, &ContourSamples)>,
+    handles: Query<(&EditHandle, &Transform), (Without<MoveGizmo>, Without<GizmoPart>)>,
     mut gizmo: Single<(&mut Transform, &mut Visibility), With<MoveGizmo>>,
+    mut parts: Query<
+        (
+            &mut GizmoPart,
+            Option<&GizmoArrow>,
+            &mut Transform,
+            &mut Visibility,
+            &mut MeshMaterial3d<StandardMaterial>,
+        ),
+        Without<MoveGizmo>,
+    >,
+    drag: Res<GizmoDrag>,
 ) {
     let placed = selection
         .0
         .and_then(|role| handles.iter().find(|(h, _)| h.0 == role))
-        .map(|(_, t)| t.translation);
+        .map(|(h, t)| (h.0, t.translation));
     let (t, v) = &mut *gizmo;
-    match placed {
-        Some(p) => {
-            t.translation = p;
-            **v = Visibility::Inherited;
-        }
-        None => **v = Visibility::Hidden,
+    let (Some((role, at)), Some(doc), Some(look)) = (placed, doc, look) else {
+        v.set_if_neq(Visibility::Hidden);
+        return;
+    };
+    t.translation = at;
+    v.set_if_neq(Visibility::Inherited);
+    // The arrows are re-aimed between drags (a drag keeps the frame it started with).
+    if drag.0.is_some() {
+        return;
+    }
+    let Some(model) = engine.0.model() else {
+        return;
+    };
+    let Some(frame) = handle_frame(role, &doc.design, model, &contour_offsets(&contours)) else {
+        return;
+    };
+    let free = freedom(role, &doc.design);
+    let dirs: Vec<(Direction, Vec3)> = free
+        .directions
+        .iter()
+        .map(|d| (*d, to_world(d.design(&frame))))
+        .filter(|(_, w)| w.length_squared() > 1e-6)
+        .collect();
+    let in_plane =
+        free.directions.contains(&Direction::X) && free.directions.contains(&Direction::Y);
+    let mut flat = 0;
+    for (mut part, arrow, mut transform, mut vis, mut material) in &mut parts {
+        let shown = match arrow {
+            Some(GizmoArrow(i)) => match dirs.get(*i) {
+                Some(&(kind, w)) => {
+                    part.set_if_neq(GizmoPart::Axis(w.normalize()));
+                    transform.set_if_neq(arrow_transform(w.normalize()));
+                    let m = if kind == Direction::Z {
+                        look.upright.clone()
+                    } else {
+                        flat += 1;
+                        if flat == 1 {
+                            look.first.clone()
+                        } else {
+                            look.second.clone()
+                        }
+                    };
+                    if material.0 != m {
+                        material.0 = m;
+                    }
+                    true
+                }
+                None => false,
+            },
+            None => in_plane,
+        };
+        vis.set_if_neq(if shown {
+            Visibility::Inherited
+        } else {
+            Visibility::Hidden
+        });
     }
 }
 

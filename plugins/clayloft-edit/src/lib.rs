@@ -9,7 +9,7 @@ pub mod ray;
 
 use bevy::prelude::*;
 
-pub use drag::{ActiveDrag, Selection};
+pub use drag::{ActiveDrag, DragHint, Selection};
 pub use history::{EditInProgress, History, HistoryCommand, PanelInUse};
 
 /// Handles, the move gizmo and undo/redo.

@@ -29,21 +29,43 @@ pub enum FileCommand {
     ExportStl(PathBuf),
 }
 
-/// The last file operation's outcome, shown in the app (errors in red).
+/// The last file operation's outcome, shown in the app (errors in red) until it expires.
 #[derive(Resource, Debug, Clone, Default, PartialEq)]
 pub struct FileStatus {
     pub message: Option<String>,
     pub is_error: bool,
+    /// When it was said.
+    pub at: Option<std::time::Instant>,
 }
+
+/// How long a file message stays in the status line: news for a few seconds, a failure long
+/// enough to read twice.
+pub const MESSAGE_LIFETIME: Duration = Duration::from_secs(8);
+pub const ERROR_LIFETIME: Duration = Duration::from_secs(30);
 
 impl FileStatus {
     fn ok(&mut self, m: String) {
         self.message = Some(m);
         self.is_error = false;
+        self.at = Some(std::time::Instant::now());
     }
     fn err(&mut self, m: String) {
         self.message = Some(m);
         self.is_error = true;
+        self.at = Some(std::time::Instant::now());
+    }
+
+    /// The message while it is current (not yet expired), at `now`.
+    pub fn current(&self, now: std::time::Instant) -> Option<&str> {
+        let life = if self.is_error {
+            ERROR_LIFETIME
+        } else {
+            MESSAGE_LIFETIME
+        };
+        let fresh = self
+            .at
+            .is_none_or(|at| now.saturating_duration_since(at) < life);
+        self.message.as_deref().filter(|_| fresh)
     }
 }
 
@@ -650,7 +672,11 @@ mod tests {
         finish_exports(&mut app);
         let status = app.world().resource::<FileStatus>().clone();
         assert!(!status.is_error, "{status:?}");
-        assert!(status.message.unwrap().starts_with("wrote"));
+        assert!(status.message.clone().unwrap().starts_with("wrote"));
+        // The news is shown for a while, then expires.
+        let at = status.at.expect("a time");
+        assert!(status.current(at).is_some());
+        assert!(status.current(at + MESSAGE_LIFETIME).is_none());
         let text = std::fs::read_to_string(&g).unwrap();
         let report = clayloft_core::check::check_gcode(
             &text,

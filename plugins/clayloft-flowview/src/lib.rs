@@ -10,9 +10,16 @@ use std::sync::mpsc::{Receiver, channel};
 
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
-use clayloft_flow::analysis::{dead_cells, speed_colour, streamlines, vortex_centre};
+use clayloft_flow::analysis::{
+    dead_cells, speed_colour, streamlines, unyielded_fraction, vortex_centre,
+};
+use clayloft_flow::cavity::{TAU_MAX, TAU_MIN};
 use clayloft_flow::groove::{Groove, MATERIALS, Material};
 use clayloft_flow::{Boundaries, Solver};
+use clayloft_ui::{Corner, toggle_on_title_click, tool_window};
+
+/// The window's title.
+const FLOW_WINDOW: &str = "Extruder flow";
 
 /// Lattice cells across the groove in the live view (the command line defaults to 120): fine
 /// enough to show the corner eddies, coarse enough to converge in a few seconds on one core.
@@ -94,8 +101,10 @@ pub struct Snapshot {
     pub v: Vec<f64>,
     pub steps: u64,
     pub change: f64,
-    pub clamped: f64,
+    /// Share of the cells whose shear stress stays below the yield stress.
+    pub unyielded: f64,
     pub reynolds: f64,
+    pub bingham: f64,
     pub cell_mm: f64,
     /// Streamlines in cells (x, y from the lower left).
     pub lines: Vec<Vec<(f64, f64)>>,
@@ -150,7 +159,14 @@ fn start(s: FlowSettings) -> Run {
             material: s.slurry(),
         };
         let l = g.to_lattice(CELLS, 1.0);
-        let mut solver = Solver::new(l.nx, l.ny, l.fluid, Boundaries::cavity(l.lid_u), 0.51, 10.0);
+        let mut solver = Solver::new(
+            l.nx,
+            l.ny,
+            l.fluid,
+            Boundaries::cavity(l.lid_u),
+            TAU_MIN,
+            TAU_MAX,
+        );
         let mut prev: Option<Vec<f64>> = None;
         while !flag.load(Ordering::Relaxed) {
             solver.advance(500);
@@ -173,8 +189,9 @@ fn start(s: FlowSettings) -> Run {
                 v: v.iter().map(|x| x / l.lid_u).collect(),
                 steps: solver.steps,
                 change,
-                clamped: solver.clamped_fraction(),
+                unyielded: unyielded_fraction(&solver.shear_stresses(), l.yield_stress()),
                 reynolds: l.reynolds,
+                bingham: l.bingham,
                 cell_mm: l.dx * 1e3,
                 lines: streamlines(&u, &v, l.nx, l.ny, 7, 1e-4 * l.lid_u),
             };
@@ -194,8 +211,10 @@ pub struct FlowViewPlugin;
 
 impl Plugin for FlowViewPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<FlowView>()
-            .add_systems(EguiPrimaryContextPass, draw_flow_window);
+        app.init_resource::<FlowView>().add_systems(
+            EguiPrimaryContextPass,
+            draw_flow_window.in_set(clayloft_ui::UiSystems::Windows),
+        );
     }
 }
 
@@ -214,7 +233,7 @@ fn speed_image(s: &Snapshot) -> egui::ColorImage {
 
 /// The speed picture with the streamlines drawn over it.
 fn speed_with_streamlines(ui: &mut egui::Ui, tex: &egui::TextureHandle, snap: &Snapshot) {
-    let size = egui::vec2(240.0, 240.0 * snap.ny as f32 / snap.nx as f32);
+    let size = egui::vec2(200.0, 200.0 * snap.ny as f32 / snap.nx as f32);
     let response = ui.image((tex.id(), size));
     let rect = response.rect;
     let painter = ui.painter_at(rect);
@@ -258,8 +277,8 @@ fn centre_line_plot(
     ui.vertical(|ui| {
         ui.label(title);
         Plot::new(id)
-            .width(190.0)
-            .height(190.0)
+            .width(155.0)
+            .height(180.0)
             .x_axis_label(x_label)
             .y_axis_label(y_label)
             .include_x(if vertical { -0.5 } else { 0.0 })
@@ -286,10 +305,9 @@ fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> R
         // Snapshots arrive from the simulation thread: keep frames coming while it runs.
         ctx.request_repaint();
     }
-    egui::Window::new("Extruder flow")
-        .default_open(view.open)
-        .pivot(egui::Align2::LEFT_BOTTOM)
-        .default_pos(egui::pos2(470.0, 690.0))
+    let opened = view.open;
+    tool_window(&ctx, FLOW_WINDOW, Corner::TopRight, opened)
+        .max_width(580.0)
         .show(&ctx, |ui| {
         ui.label(egui::RichText::new(
             "The clay inside one turn of the extruder's screw groove, seen in cross-section. The barrel (top) slides over the groove as the screw turns and drags the clay round in a vortex; clay in the lower corners barely moves (dead zones). A yield-stress slurry only flows where it is sheared hard enough.",
@@ -329,7 +347,7 @@ fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> R
             ui.label("starting…");
             return;
         };
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             if let Some(tex) = &view.texture {
                 speed_with_streamlines(ui, tex, snap);
             }
@@ -346,17 +364,22 @@ fn draw_flow_window(mut contexts: EguiContexts, mut view: ResMut<FlowView>) -> R
         let (l, r) = dead_cells(&snap.u, &snap.v, snap.nx, snap.ny, 0.01);
         let a = snap.cell_mm * snap.cell_mm;
         ui.label(format!(
-            "Reynolds number {:.1e} (viscous: inertia plays no part) · vortex centre ({:.2}, {:.2}) mm · dead zones {:.2} / {:.2} mm² · {:.0} % of cells unyielded or at the viscosity limit",
+            "Reynolds number {:.1e} (viscous: inertia plays no part) · Bingham number {:.1} · vortex centre ({:.2}, {:.2}) mm · dead zones {:.2} / {:.2} mm² · {:.0} % of the slurry unyielded",
             snap.reynolds,
+            snap.bingham,
             cx * snap.nx as f64 * snap.cell_mm,
             cy * snap.ny as f64 * snap.cell_mm,
             l as f64 * a,
             r as f64 * a,
-            snap.clamped * 100.0
+            snap.unyielded * 100.0
         ));
+        ui.label(egui::RichText::new(
+            "Bingham number: the yield stress against the stress the barrel's shearing makes. The slower the screw, the larger it is, and the more of the slurry stands still (unyielded: its stress stays below the yield stress).",
+        ).small().weak());
         let state = if snap.change < 1e-6 { "converged" } else { "running" };
         ui.label(egui::RichText::new(format!("{state}: {} steps, change {:.1e}", snap.steps, snap.change)).small().weak());
     });
+    toggle_on_title_click(&ctx, FLOW_WINDOW, opened);
     Ok(())
 }
 

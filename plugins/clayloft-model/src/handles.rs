@@ -186,6 +186,146 @@ pub fn handle_frame(
     }
 }
 
+/// The name of a contour for people: the foot stands on the bed, the rim is the top.
+fn contour_name(role: ContourRole) -> &'static str {
+    match role {
+        ContourRole::Lower => "foot",
+        ContourRole::Upper => "rim",
+    }
+}
+
+/// What a handle stands for, in words (points counted from 1, as people count):
+/// "rim radius", "foot star notch radius", "rim point 3",
+/// "vertical control line 1, point 3: height and offset".
+pub fn describe(role: HandleRole, design: &Design) -> String {
+    match role {
+        HandleRole::Contour { contour, param } => {
+            let name = contour_name(contour);
+            match (contour_spec(design, contour), param) {
+                (_, ContourParam::Point(i)) => format!("{name} point {}", i + 1),
+                (ContourSpec::Polygon { .. }, _) => format!("{name} polygon radius (to a corner)"),
+                (ContourSpec::Rose { .. }, _) => format!("{name} rose radius (at 0°)"),
+                (_, ContourParam::Radius) => format!("{name} radius"),
+                (_, ContourParam::RadiusX) => format!("{name} ellipse half-width along x"),
+                (_, ContourParam::RadiusY) => format!("{name} ellipse half-width along y"),
+                (_, ContourParam::Outer) => format!("{name} star tip radius"),
+                (_, ContourParam::Inner) => format!("{name} star notch radius"),
+            }
+        }
+        HandleRole::Line { kind, line, point } => {
+            let what = match kind {
+                LineKind::Vertical => "vertical",
+                LineKind::Horizontal => "horizontal",
+            };
+            format!(
+                "{what} control line {}, point {}: {}",
+                line + 1,
+                point + 1,
+                freedom(role, design).moves
+            )
+        }
+    }
+}
+
+/// How a handle may move: the directions (design space, unit or zero-length when they depend
+/// on the frame: see [`Freedom::directions`]), in words, and why the other directions are fixed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Freedom {
+    pub moves: &'static str,
+    pub directions: Vec<Direction>,
+    /// Why a drag across the free directions does nothing.
+    pub locked: &'static str,
+}
+
+/// One direction a handle moves in, resolved against its [`HandleFrame`] by [`Direction::world`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Direction {
+    /// Along the frame's direction in the bed plane (a radius, a control-line offset).
+    Frame,
+    X,
+    Y,
+    /// Up.
+    Z,
+}
+
+impl Direction {
+    /// The unit direction in design space.
+    pub fn design(self, frame: &HandleFrame) -> DVec3 {
+        match self {
+            Direction::Frame => frame.dir.normalize_or_zero().extend(0.0),
+            Direction::X => DVec3::X,
+            Direction::Y => DVec3::Y,
+            Direction::Z => DVec3::Z,
+        }
+    }
+}
+
+/// The directions a handle of `role` moves in (what the move gizmo shows) and why the rest are
+/// fixed (what a drag across them says).
+pub fn freedom(role: HandleRole, design: &Design) -> Freedom {
+    match role {
+        HandleRole::Contour {
+            param: ContourParam::Point(_),
+            ..
+        } => Freedom {
+            moves: "anywhere in the contour's plane",
+            directions: vec![Direction::X, Direction::Y],
+            locked: "a contour point stays in its contour's plane: the contour's height is the vessel's foot or rim",
+        },
+        HandleRole::Contour { .. } => Freedom {
+            moves: "in and out along its radius",
+            directions: vec![Direction::Frame],
+            locked: "a radius handle moves only along its radius: the shape's other values are in the panel",
+        },
+        HandleRole::Line {
+            kind: LineKind::Vertical,
+            line,
+            point,
+        } => {
+            let n = design
+                .control
+                .vertical
+                .get(line)
+                .map_or(0, |v| v.points.len());
+            if point == 0 || point + 1 >= n {
+                Freedom {
+                    moves: "offset (in and out); an end point stays at the line's end",
+                    directions: vec![Direction::Frame],
+                    locked: "the end points of a vertical control line keep their height (the foot and the rim): drag it in or out",
+                }
+            } else {
+                Freedom {
+                    moves: "height and offset",
+                    directions: vec![Direction::Z, Direction::Frame],
+                    locked: "a vertical control line stays at its angle around the vessel: change the angle in the panel",
+                }
+            }
+        }
+        HandleRole::Line {
+            kind: LineKind::Horizontal,
+            ..
+        } => Freedom {
+            moves: "up and down",
+            directions: vec![Direction::Z],
+            locked: "a horizontal control line's point moves only up and down: its angle around the vessel is set in the panel",
+        },
+    }
+}
+
+/// The handle a click picks among those drawn on the same spot (`stack`, in a stable order): the
+/// one after the current selection if that is in the stack (click again, the next one), else the
+/// one clicked.
+pub fn next_pick(
+    stack: &[HandleRole],
+    clicked: HandleRole,
+    current: Option<HandleRole>,
+) -> HandleRole {
+    match current.and_then(|c| stack.iter().position(|r| *r == c)) {
+        Some(i) if stack.len() > 1 => stack[(i + 1) % stack.len()],
+        _ => clicked,
+    }
+}
+
 /// Where the handle of `role` sits (design space), given its frame.
 pub fn handle_position(role: HandleRole, design: &Design, f: &HandleFrame) -> Option<DVec3> {
     match role {
@@ -428,6 +568,81 @@ points = [[0.0, 0.0], [0.5, 5.0], [1.0, 0.0]]
 "#,
         )
         .unwrap()
+    }
+
+    #[test]
+    fn handles_are_described_in_words() {
+        let d = design();
+        let words: Vec<String> = handle_roles(&d).iter().map(|r| describe(*r, &d)).collect();
+        assert_eq!(words[0], "foot star tip radius");
+        assert_eq!(words[1], "foot star notch radius");
+        assert_eq!(words[3], "rim point 2");
+        assert_eq!(
+            words[6],
+            "vertical control line 1, point 1: offset (in and out); an end point stays at the line's end"
+        );
+        assert_eq!(
+            words[7],
+            "vertical control line 1, point 2: height and offset"
+        );
+        assert!(
+            words
+                .iter()
+                .all(|w| !w.contains('{') && !w.contains("Line"))
+        );
+    }
+
+    #[test]
+    fn clicking_a_stack_again_picks_the_next() {
+        let roles = handle_roles(&design());
+        let stack = [roles[0], roles[6], roles[7]];
+        // First click: the one hit; again: the next, round and round.
+        assert_eq!(next_pick(&stack, roles[6], None), roles[6]);
+        assert_eq!(next_pick(&stack, roles[6], Some(roles[6])), roles[7]);
+        assert_eq!(next_pick(&stack, roles[6], Some(roles[7])), roles[0]);
+        // A selection elsewhere does not cycle; a lone handle stays picked.
+        assert_eq!(next_pick(&stack, roles[0], Some(roles[3])), roles[0]);
+        assert_eq!(next_pick(&[roles[3]], roles[3], Some(roles[3])), roles[3]);
+    }
+
+    #[test]
+    fn each_handle_moves_in_the_directions_its_value_has() {
+        let d = design();
+        for role in handle_roles(&d) {
+            // A vertical line's frame stands at its point's height, as the model gives it.
+            let z = match role {
+                HandleRole::Line {
+                    kind: LineKind::Vertical,
+                    line,
+                    point,
+                } => d.control.vertical[line].points[point][0] * 100.0,
+                _ => 0.0,
+            };
+            let f = frame(DVec3::new(0.0, 0.0, z), DVec2::new(0.6, 0.8));
+            let free = freedom(role, &d);
+            // Moving along each free direction changes the design; across them it does not.
+            let at = handle_position(role, &d, &f).unwrap();
+            for dir in &free.directions {
+                let mut moved = d.clone();
+                assert!(
+                    set_handle(role, &mut moved, &f, at + dir.design(&f) * 3.0),
+                    "{}: {dir:?} does nothing",
+                    describe(role, &d)
+                );
+            }
+            let dirs: Vec<DVec3> = free.directions.iter().map(|x| x.design(&f)).collect();
+            let across = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(-0.8, 0.6, 0.0)]
+                .into_iter()
+                .find(|c| dirs.iter().all(|d| d.dot(*c).abs() < 1e-9));
+            if let Some(c) = across {
+                let mut moved = d.clone();
+                assert!(
+                    !set_handle(role, &mut moved, &f, at + c * 3.0),
+                    "{}: moved across its free directions ({c:?})",
+                    describe(role, &d)
+                );
+            }
+        }
     }
 
     #[test]

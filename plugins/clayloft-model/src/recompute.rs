@@ -81,11 +81,19 @@ pub fn recompute_model(
     let update = match engine.0.update(&doc.design) {
         Ok(u) => u,
         Err(e) => {
-            status.error = Some(e.to_string());
+            let mut errors = vec![e];
+            for other in clayloft_core::validate::validate_all(&doc.design) {
+                if !errors.contains(&other) {
+                    errors.push(other);
+                }
+            }
+            status.set_if_neq(ModelStatus { errors });
             return;
         }
     };
-    status.error = None;
+    if status.is_stale() {
+        status.errors.clear();
+    }
     if update.is_nothing() {
         return;
     }

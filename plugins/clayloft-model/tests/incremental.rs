@@ -159,7 +159,7 @@ fn invalid_edit_keeps_the_last_good_surface_and_says_why() {
         .layer_height = -1.0;
     app.update();
     let status = app.world().resource::<ModelStatus>().clone();
-    assert!(status.error.unwrap().contains("printer.layer_height"));
+    assert!(status.error().unwrap().contains("printer.layer_height"));
     assert_eq!(surface(&mut app).0.sections, before);
     // A design too wide for the bed fails after the sections were reshaped; fixing it rebuilds.
     app.world_mut()
@@ -176,7 +176,7 @@ fn invalid_edit_keeps_the_last_good_surface_and_says_why() {
     assert!(
         app.world()
             .resource::<ModelStatus>()
-            .error
+            .error()
             .as_ref()
             .unwrap()
             .contains("bed")
@@ -187,7 +187,7 @@ fn invalid_edit_keeps_the_last_good_surface_and_says_why() {
         .printer
         .bed_x = 180.0;
     app.update();
-    assert!(app.world().resource::<ModelStatus>().error.is_none());
+    assert!(app.world().resource::<ModelStatus>().errors.is_empty());
     assert_matches_pipeline(&mut app);
 }
 

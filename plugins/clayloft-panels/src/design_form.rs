@@ -5,11 +5,25 @@ use clayloft_core::Design;
 use clayloft_core::design::{
     Combine, ContourSpec, ExtrusionMode, HorizontalLine, Texture, VerticalLine, Wave, WaveKind,
 };
-use clayloft_model::handles::HandleRole;
+use clayloft_model::handles::{HandleRole, describe, freedom};
 
-use crate::widgets::{count, explain, field, field_as, number, point_list};
+use crate::widgets::{count, explain, field, field_as_at, number, point_list, set_field_problems};
+use clayloft_model::ModelStatus;
 
-pub fn design_form(ui: &mut egui::Ui, d: &mut Design, selected: Option<HandleRole>) {
+pub fn design_form(
+    ui: &mut egui::Ui,
+    d: &mut Design,
+    selected: Option<HandleRole>,
+    status: &ModelStatus,
+) {
+    set_field_problems(
+        ui,
+        status
+            .errors
+            .iter()
+            .map(|e| (e.field.clone(), e.message.clone()))
+            .collect(),
+    );
     ui.horizontal(|ui| {
         ui.label("Name");
         ui.text_edit_singleline(&mut d.name);
@@ -18,7 +32,9 @@ pub fn design_form(ui: &mut egui::Ui, d: &mut Design, selected: Option<HandleRol
         explain(
             ui,
             &format!(
-                "selected handle: {role:?} — drag it, or use the gizmo arrows for one axis at a time"
+                "selected: {} — moves {}. Drag it, or drag a gizmo arrow to move along one direction.",
+                describe(role, d),
+                freedom(role, d).moves
             ),
         );
     }
@@ -64,6 +80,7 @@ fn shape(ui: &mut egui::Ui, d: &mut Design) {
     field(ui, "shape.height", &mut s.height);
     count(
         ui,
+        "shape.samples",
         "Samples",
         &mut s.samples,
         3..=20_000,
@@ -71,6 +88,7 @@ fn shape(ui: &mut egui::Ui, d: &mut Design) {
     );
     count(
         ui,
+        "shape.base_layers",
         "Base layers",
         &mut s.base_layers,
         0..=20,
@@ -195,18 +213,37 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
             }
         });
     match spec {
-        ContourSpec::Circle { radius } => field_as(ui, "contour.radius", radius, None),
+        ContourSpec::Circle { radius } => field_as_at(
+            ui,
+            "contour.radius",
+            &format!("shape.{id}.radius"),
+            radius,
+            None,
+        ),
         ContourSpec::Ellipse { rx, ry } => {
-            field_as(ui, "contour.rx", rx, None);
-            field_as(ui, "contour.ry", ry, None);
+            field_as_at(ui, "contour.rx", &format!("shape.{id}.rx"), rx, None);
+            field_as_at(ui, "contour.ry", &format!("shape.{id}.ry"), ry, None);
         }
         ContourSpec::Polygon {
             sides,
             radius,
             corner_radius,
         } => {
-            count(ui, "Sides", sides, 3..=64, "Number of straight sides.");
-            field_as(ui, "contour.radius", radius, None);
+            count(
+                ui,
+                &format!("shape.{id}.sides"),
+                "Sides",
+                sides,
+                3..=64,
+                "Number of straight sides.",
+            );
+            field_as_at(
+                ui,
+                "contour.radius",
+                &format!("shape.{id}.radius"),
+                radius,
+                None,
+            );
             number(
                 ui,
                 "Corner radius",
@@ -221,16 +258,41 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
             outer_radius,
             inner_radius,
         } => {
-            count(ui, "Points", points, 2..=64, "Number of tips.");
-            field_as(ui, "contour.outer_radius", outer_radius, None);
-            field_as(ui, "contour.inner_radius", inner_radius, None);
+            count(
+                ui,
+                &format!("shape.{id}.points"),
+                "Points",
+                points,
+                2..=64,
+                "Number of tips.",
+            );
+            field_as_at(
+                ui,
+                "contour.outer_radius",
+                &format!("shape.{id}.outer_radius"),
+                outer_radius,
+                None,
+            );
+            field_as_at(
+                ui,
+                "contour.inner_radius",
+                &format!("shape.{id}.inner_radius"),
+                inner_radius,
+                None,
+            );
         }
         ContourSpec::Rose {
             radius,
             amplitude,
             petals,
         } => {
-            field_as(ui, "contour.radius", radius, None);
+            field_as_at(
+                ui,
+                "contour.radius",
+                &format!("shape.{id}.radius"),
+                radius,
+                None,
+            );
             number(
                 ui,
                 "Amplitude",
@@ -239,7 +301,14 @@ fn contour(ui: &mut egui::Ui, id: &str, spec: &mut ContourSpec) {
                 0.0..=500.0,
                 "How far the petals reach out and in.",
             );
-            count(ui, "Petals", petals, 1..=64, "Number of petals k.");
+            count(
+                ui,
+                &format!("shape.{id}.petals"),
+                "Petals",
+                petals,
+                1..=64,
+                "Number of petals k.",
+            );
         }
         ContourSpec::Spline { points } => {
             explain(
@@ -465,8 +534,20 @@ fn wave(ui: &mut egui::Ui, id: &str, w: &mut Option<Wave>, period_unit: &str) {
                 ui.selectable_value(&mut w.wave, WaveKind::Triangle, "triangle");
                 ui.selectable_value(&mut w.wave, WaveKind::Square, "square");
             });
-        field_as(ui, "wave.period", &mut w.period, Some(period_unit));
-        field_as(ui, "wave.amplitude", &mut w.amplitude, None);
+        field_as_at(
+            ui,
+            "wave.period",
+            &format!("texture.{id}.period"),
+            &mut w.period,
+            Some(period_unit),
+        );
+        field_as_at(
+            ui,
+            "wave.amplitude",
+            &format!("texture.{id}.amplitude"),
+            &mut w.amplitude,
+            None,
+        );
     }
 }
 
@@ -588,14 +669,57 @@ mod tests {
     use egui_kittest::Harness;
     use egui_kittest::kittest::Queryable;
 
-    fn form() -> Harness<'static, Design> {
-        let design = clayloft_core::load::parse_design(
+    fn design() -> Design {
+        clayloft_core::load::parse_design(
             "version = 1\n[shape]\nheight = 60.0\nlower = { type = \"circle\", radius = 40.0 }\nupper = { type = \"circle\", radius = 45.0 }\n",
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    fn form() -> Harness<'static, Design> {
+        form_of(design())
+    }
+
+    /// The form on `design`, with the validator's problems of it as the app would pass them.
+    fn form_of(design: Design) -> Harness<'static, Design> {
         Harness::builder()
             .with_size(egui::vec2(420.0, 4000.0))
-            .build_ui_state(|ui, d: &mut Design| design_form(ui, d, None), design)
+            .build_ui_state(
+                |ui, d: &mut Design| {
+                    let status = ModelStatus {
+                        errors: clayloft_core::validate::validate_all(d),
+                    };
+                    design_form(ui, d, None, &status)
+                },
+                design,
+            )
+    }
+
+    #[test]
+    fn an_invalid_value_is_said_next_to_its_field_and_kept() {
+        // Out of range: said under the field, not clamped away.
+        let mut d = design();
+        d.shape.height = -5.0;
+        d.shape.samples = 0;
+        let mut h = form_of(d);
+        h.run();
+        assert_eq!(h.state().shape.height, -5.0, "the value is kept as typed");
+        assert_eq!(h.state().shape.samples, 0);
+        assert!(h.query_by_label_contains("-5 mm is outside").is_some());
+        assert!(h.query_by_label_contains("0 is outside 3").is_some());
+        // In range but refused with another field: the validator's words under the field.
+        let mut d = design();
+        d.printer.max_z = 50.0;
+        let mut h = form_of(d);
+        h.run();
+        assert!(
+            h.query_by_label_contains("taller than the printer's build height")
+                .is_some()
+        );
+        // A valid design shows no problem.
+        let mut h = form();
+        h.run();
+        assert!(h.query_by_label_contains("is outside").is_none());
     }
 
     #[test]

@@ -11,11 +11,17 @@ use std::path::PathBuf;
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use clayloft_core::gcode::format_duration;
-use clayloft_edit::{HistoryCommand, PanelInUse, Selection};
+use clayloft_edit::{DragHint, HistoryCommand, PanelInUse, Selection};
 use clayloft_files::{FileCommand, FileStatus};
 use clayloft_model::*;
 use clayloft_replay::{Replay, ReplayPath};
 use clayloft_view::{FrameVessel, ViewSettings, WallStats};
+
+/// The toolpath the status line's figures are of (its address), its length and its print time.
+type PathFigures = (usize, f64, f64);
+
+/// How long a pick or drag hint stays in the status line.
+const HINT_LIFETIME: std::time::Duration = std::time::Duration::from_secs(12);
 
 /// Paths typed in the file bar.
 #[derive(Resource, Debug, Clone, Default)]
@@ -31,10 +37,15 @@ pub struct PanelsPlugin;
 
 impl Plugin for PanelsPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<FileFields>().add_systems(
-            EguiPrimaryContextPass,
-            (draw_panels, draw_source_previews).chain(),
-        );
+        app.init_resource::<FileFields>()
+            .add_systems(
+                EguiPrimaryContextPass,
+                draw_panels.in_set(clayloft_ui::UiSystems::Panels),
+            )
+            .add_systems(
+                EguiPrimaryContextPass,
+                draw_source_previews.in_set(clayloft_ui::UiSystems::Windows),
+            );
     }
 }
 
@@ -54,8 +65,15 @@ fn draw_panels(
     toolpath: Query<&ToolpathPath>,
     selection: Res<Selection>,
     (mut panel, mut frame): (ResMut<PanelInUse>, MessageWriter<FrameVessel>),
-    mut path_figures: Local<(usize, f64, f64)>,
+    (mut path_figures, hint, mut hint_since): (
+        Local<PathFigures>,
+        Res<DragHint>,
+        Local<Option<std::time::Instant>>,
+    ),
 ) -> Result {
+    if hint.is_changed() {
+        *hint_since = Some(std::time::Instant::now());
+    }
     let ctx = contexts.ctx_mut()?.clone();
     let Some(mut doc) = doc else { return Ok(()) };
     if fields.filled_from.as_ref() != Some(&doc.path) {
@@ -172,10 +190,22 @@ fn draw_panels(
                     );
                 }
             }
-            if let Some(e) = &status.error {
+            if status.is_stale() {
+                ui.colored_label(
+                    egui::Color32::from_rgb(240, 200, 90),
+                    "showing the last design that could be built (faded) — to fix:",
+                );
+            }
+            for e in &status.errors {
                 ui.colored_label(egui::Color32::from_rgb(255, 90, 90), format!("error: {e}"));
             }
-            if let Some(m) = &file_status.message {
+            let now = std::time::Instant::now();
+            if let Some(h) = &hint.0
+                && hint_since.is_some_and(|t| now.duration_since(t) < HINT_LIFETIME)
+            {
+                ui.label(h);
+            }
+            if let Some(m) = file_status.current(now) {
                 let c = if file_status.is_error {
                     egui::Color32::from_rgb(255, 90, 90)
                 } else {
@@ -191,7 +221,7 @@ fn draw_panels(
         .default_size(330.0)
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                design_form::design_form(ui, &mut design, selection.0);
+                design_form::design_form(ui, &mut design, selection.0, &status);
             });
         });
 
@@ -204,10 +234,18 @@ fn draw_panels(
                 replay_panel(ui, &mut edited, &replay_path);
                 replay.set_if_neq(edited);
                 ui.separator();
-                findings_panel(ui, vessel.iter().next(), toolpath.iter().next(), &design);
+                findings_panel(
+                    ui,
+                    vessel.iter().next(),
+                    toolpath.iter().next(),
+                    &design,
+                    &status,
+                );
             });
         });
 
+    // What is left between the panels is the 3D view: the tool windows stay inside it.
+    clayloft_ui::set_tool_area(&ctx, root.available_rect_before_wrap());
     if design != doc.design {
         doc.design = design;
     }
@@ -313,6 +351,7 @@ fn findings_panel(
     surface: Option<&VesselSurface>,
     path: Option<&ToolpathPath>,
     design: &clayloft_core::Design,
+    status: &ModelStatus,
 ) {
     ui.heading("Constraints");
     ui.label(
@@ -323,9 +362,16 @@ fn findings_panel(
         .small()
         .weak(),
     );
+    if status.is_stale() {
+        // Nothing is claimed about a design that could not be built.
+        ui.colored_label(
+            egui::Color32::from_rgb(240, 200, 90),
+            "not checked: the design has an error (see the status line). What follows is about the last design that could be built.",
+        );
+    }
     let Some(s) = surface else { return };
     let path_findings = path.map(|p| p.0.findings.as_slice()).unwrap_or_default();
-    if s.0.findings.is_empty() && path_findings.is_empty() {
+    if s.0.findings.is_empty() && path_findings.is_empty() && !status.is_stale() {
         ui.colored_label(
             egui::Color32::from_rgb(150, 220, 150),
             "the design keeps every limit as drawn",

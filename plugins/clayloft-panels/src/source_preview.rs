@@ -9,6 +9,7 @@ use clayloft_core::Design;
 use clayloft_core::design::ContourSpec;
 use clayloft_core::outline::resolve;
 use clayloft_core::trace;
+use clayloft_ui::{Corner, toggle_on_title_click, tool_window};
 
 /// Largest side of the picture shown, pixels.
 const PREVIEW_SIDE: u32 = 220;
@@ -174,12 +175,13 @@ pub fn source_windows(ctx: &egui::Context, design: &Design, previews: &mut [Sour
             continue;
         }
         previews[i].refresh(ctx, label, spec, base);
-        egui::Window::new(label)
-            .default_pos(egui::pos2(340.0, 60.0 + 300.0 * i as f32))
+        let corner = [Corner::BottomLeft, Corner::BottomRight][i];
+        tool_window(ctx, label, corner, true)
             .resizable(false)
             .show(ctx, |ui| {
                 ui.label(egui::RichText::new("The red line is the outline traced from the file; the threshold and size are in the left panel.").small().weak());
                 previews[i].show(ui);
             });
+        toggle_on_title_click(ctx, label, true);
     }
 }

@@ -73,7 +73,10 @@ impl Plugin for PrinterPlugin {
             ..default()
         })
         .add_systems(Update, pump_link_events)
-        .add_systems(EguiPrimaryContextPass, draw_printer_window);
+        .add_systems(
+            EguiPrimaryContextPass,
+            draw_printer_window.in_set(clayloft_ui::UiSystems::Windows),
+        );
     }
 }
 
@@ -202,10 +205,7 @@ fn draw_printer_window(
         // (the app otherwise sleeps until the next input).
         ctx.request_repaint();
     }
-    egui::Window::new("Printer")
-        .default_open(false)
-        .pivot(egui::Align2::LEFT_BOTTOM)
-        .default_pos(egui::pos2(340.0, 690.0))
+    clayloft_ui::tool_window(&ctx, PRINTER_WINDOW, clayloft_ui::Corner::TopLeft, false)
         .show(&ctx, |ui| {
             ui.label(egui::RichText::new("Streams the design's G-code line by line (Marlin protocol: numbered lines, checksums, resends). Try it on `clayloft fake-printer`.").small().weak());
             ui.horizontal(|ui| {
@@ -307,8 +307,12 @@ fn draw_printer_window(
                 }
             });
         });
+    clayloft_ui::toggle_on_title_click(&ctx, PRINTER_WINDOW, false);
     Ok(())
 }
+
+/// The window's title.
+const PRINTER_WINDOW: &str = "Printer";
 
 #[cfg(test)]
 mod tests {

@@ -71,6 +71,7 @@ impl Plugin for ViewPlugin {
                 (
                     frame_camera_on_first_surface,
                     rebuild_wall_mesh,
+                    fade_stale_vessel,
                     rebuild_toolpath_lines,
                     update_bed,
                     apply_view_settings,
@@ -287,6 +288,30 @@ fn rebuild_wall_mesh(
     let buffers = wall_buffers(&surface.0, doc.design.printer.max_overhang_deg);
     stats.violating_points = buffers.violating;
     let _ = meshes.insert(wall.0.id(), buffers.into_mesh());
+}
+
+/// While the design being edited cannot be built, the wall shown is the last one that could: it
+/// is drawn faded (grey and see-through) so that nobody takes it for the edit.
+fn fade_stale_vessel(
+    status: Res<ModelStatus>,
+    wall: Single<&MeshMaterial3d<StandardMaterial>, With<WallView>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    if !status.is_changed() {
+        return;
+    }
+    let (colour, alpha) = if status.is_stale() {
+        (Color::srgba(0.6, 0.6, 0.65, 0.35), AlphaMode::Blend)
+    } else {
+        (Color::WHITE, AlphaMode::Opaque)
+    };
+    if let Some(m) = materials.get(&wall.0)
+        && (m.base_color != colour || m.alpha_mode != alpha)
+        && let Some(mut m) = materials.get_mut(&wall.0)
+    {
+        m.base_color = colour;
+        m.alpha_mode = alpha;
+    }
 }
 
 /// Retained gizmos ignore `Visibility`: a hidden toolpath is an empty line set.
