@@ -160,7 +160,23 @@ fn invalid_edit_keeps_the_last_good_surface_and_says_why() {
     app.update();
     let status = app.world().resource::<ModelStatus>().clone();
     assert!(status.error().unwrap().contains("printer.layer_height"));
+    assert!(status.is_stale());
     assert_eq!(surface(&mut app).0.sections, before);
+    // Two problems at once: both are listed, each under its own field.
+    app.world_mut()
+        .resource_mut::<DesignDoc>()
+        .design
+        .printer
+        .print_speed = -5.0;
+    app.update();
+    let status = app.world().resource::<ModelStatus>().clone();
+    assert!(status.for_field("printer.layer_height").is_some(), "{status:?}");
+    assert!(status.for_field("printer.print_speed").is_some(), "{status:?}");
+    app.world_mut()
+        .resource_mut::<DesignDoc>()
+        .design
+        .printer
+        .print_speed = 20.0;
     // A design too wide for the bed fails after the sections were reshaped; fixing it rebuilds.
     app.world_mut()
         .resource_mut::<DesignDoc>()

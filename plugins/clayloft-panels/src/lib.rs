@@ -386,3 +386,40 @@ fn findings_panel(
         ui.colored_label(color, f.to_string());
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable;
+
+    /// The constraint panel of a design that keeps every limit, with and without an error in
+    /// the edit that followed it.
+    fn panel(status: ModelStatus) -> Harness<'static> {
+        let design = clayloft_core::load::parse_design(
+            "version = 1\n[shape]\nheight = 60.0\nlower = { type = \"circle\", radius = 40.0 }\nupper = { type = \"circle\", radius = 45.0 }\n",
+        )
+        .unwrap();
+        let job = clayloft_core::run(&design).unwrap();
+        let (surface, path) = (VesselSurface(job.surface), ToolpathPath(job.toolpath));
+        Harness::builder()
+            .with_size(egui::vec2(320.0, 600.0))
+            .build_ui(move |ui| findings_panel(ui, Some(&surface), Some(&path), &design, &status))
+    }
+
+    #[test]
+    fn the_constraint_panel_claims_nothing_about_an_edit_it_could_not_build() {
+        let mut h = panel(ModelStatus::default());
+        h.run();
+        assert!(h.query_by_label("the design keeps every limit as drawn").is_some());
+        let mut h = panel(ModelStatus {
+            errors: vec![clayloft_core::validate::FieldError::new(
+                "texture.x.amplitude",
+                "50 mm is outside …",
+            )],
+        });
+        h.run();
+        assert!(h.query_by_label("the design keeps every limit as drawn").is_none());
+        assert!(h.query_by_label_contains("not checked: the design has an error").is_some());
+    }
+}
