@@ -351,10 +351,40 @@ pub struct Shape {
     pub center: Option<[f64; 2]>,
     #[serde(default = "default_base_layers")]
     pub base_layers: usize,
-    /// Contour at z = 0.
+    /// Contour at z = 0 (not given for a design from a mesh).
+    #[serde(
+        default = "ContourSpec::missing",
+        skip_serializing_if = "ContourSpec::is_missing"
+    )]
     pub lower: ContourSpec,
-    /// Contour at z = height.
+    /// Contour at z = height (not given for a design from a mesh).
+    #[serde(
+        default = "ContourSpec::missing",
+        skip_serializing_if = "ContourSpec::is_missing"
+    )]
     pub upper: ContourSpec,
+    /// The shape from a mesh instead of two contours (SPEC §15): the wall follows the mesh's
+    /// slices; the height comes from the mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<MeshSource>,
+}
+
+/// A vessel mesh to slice (`[shape.mesh]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSource {
+    /// The STL file, relative to the design file's folder.
+    pub path: std::path::PathBuf,
+    /// Scale factor applied to the mesh (1 = its numbers are millimetres; 25.4 for inches).
+    #[serde(default = "default_mesh_scale")]
+    pub scale: f64,
+    /// Turn about the x axis before slicing, degrees (90 stands a Y-up export upright).
+    #[serde(default)]
+    pub rotate_x: f64,
+}
+
+fn default_mesh_scale() -> f64 {
+    1.0
 }
 
 fn default_height() -> f64 {
@@ -365,6 +395,19 @@ fn default_samples() -> usize {
 }
 fn default_base_layers() -> usize {
     2
+}
+
+impl ContourSpec {
+    /// The value of a contour the design file does not give (a design from a mesh has none):
+    /// refused by the validator unless `[shape.mesh]` is there, and never written back.
+    pub fn missing() -> ContourSpec {
+        ContourSpec::Circle { radius: -1.0 }
+    }
+
+    /// Whether this is [`ContourSpec::missing`].
+    pub fn is_missing(&self) -> bool {
+        *self == ContourSpec::missing()
+    }
 }
 
 /// A closed contour, by kind. Dimensions in mm, centred on the origin before alignment.

@@ -32,6 +32,7 @@ pub mod geometry;
 pub mod interp;
 pub mod load;
 pub mod loft;
+pub mod mesh;
 pub mod motion;
 pub mod outline;
 pub mod parallel;

@@ -83,11 +83,36 @@ pub fn build_surface(design: &Design) -> Result<Surface, FieldError> {
 pub fn finish_surface(
     design: &Design,
     model: &ShapeModel,
+    sections: Vec<Section>,
+    findings: Vec<Finding>,
+    displacements: Option<&[Vec<f64>]>,
+) -> Result<Surface, FieldError> {
+    let grid = SectionGrid {
+        center: model.loft.center,
+        layers: model.layers,
+        layer_pitch: model.layer_pitch,
+    };
+    finish_sections(design, grid, sections, findings, displacements)
+}
+
+/// Where the sections of a surface stand: the vessel's centre on the bed, the layer count and
+/// the nominal pitch (from the layer plan of a lofted design, or the slicing of a mesh).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SectionGrid {
+    pub center: DVec2,
+    pub layers: usize,
+    pub layer_pitch: f64,
+}
+
+/// [`finish_surface`] for sections from anywhere (a lofted design's or a mesh's slices).
+pub fn finish_sections(
+    design: &Design,
+    grid: SectionGrid,
     mut sections: Vec<Section>,
     mut findings: Vec<Finding>,
     displacements: Option<&[Vec<f64>]>,
 ) -> Result<Surface, FieldError> {
-    let center = model.loft.center;
+    let center = grid.center;
     findings.extend(correct_shape(design, &mut sections, 1));
     if let Some(tex) = &design.texture {
         let enforce = design.constraints.enforce;
@@ -129,8 +154,8 @@ pub fn finish_surface(
     let (metrics, point_leans_deg) = measure_with_leans(&sections);
     let surface = Surface {
         sections,
-        layers: model.layers,
-        layer_pitch: model.layer_pitch,
+        layers: grid.layers,
+        layer_pitch: grid.layer_pitch,
         center,
         findings,
         metrics,

@@ -29,7 +29,7 @@ use glam::DVec2;
 use crate::control::VerticalProfile;
 use crate::design::{BedShape, ContourSpec, Design, HorizontalLine, Origin, Texture, VerticalLine};
 use crate::loft::{LoftInput, SampledContour, sample_contour};
-use crate::pipeline::{PrintJob, Surface, finish_surface};
+use crate::pipeline::{PrintJob, Surface, finish_sections};
 use crate::report::Finding;
 use crate::section::Section;
 use crate::shape::ShapeModel;
@@ -186,6 +186,44 @@ impl Update {
     }
 }
 
+/// The stages after the shape: the texture's displacement table, the corrected surface, the base
+/// fill and the toolpath.
+#[derive(Debug, Clone, Default)]
+struct LaterStages {
+    /// The texture's displacements on the section grid (no shape input: kept while shaping).
+    texture: Stage<TextureKey, Vec<Vec<f64>>>,
+    surface: Stage<SurfaceKey, Arc<Surface>>,
+    base: Stage<BaseKey, Vec<crate::base_fill::BaseFill>>,
+    toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
+}
+
+/// Inputs of a mesh: the file (and when it last changed, so an edited file is read again) and
+/// how it is placed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshKey {
+    pub path: PathBuf,
+    pub stamp: Option<(std::time::SystemTime, u64)>,
+    pub scale: f64,
+    pub rotate_x: f64,
+}
+
+/// Inputs of a mesh's slices: the mesh (by revision) and the layer height.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SliceKey {
+    pub mesh: u64,
+    pub layer_height: f64,
+}
+
+/// Inputs of the wall sections of a mesh: its slices (by revision), the samples, the inset and
+/// the centre on the bed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshWallKey {
+    pub slices: u64,
+    pub samples: usize,
+    pub line_width: f64,
+    pub center: DVec2,
+}
+
 /// The incremental engine: the cached stages of one design being edited.
 #[derive(Debug, Clone, Default)]
 pub struct Session {
@@ -194,11 +232,15 @@ pub struct Session {
     sections: Vec<Stage<SectionKey, Section>>,
     /// Bumped whenever any section is recomputed or the section count changes.
     sections_revision: u64,
-    /// The texture's displacements on the section grid (no shape input: kept while shaping).
-    texture: Stage<TextureKey, Vec<Vec<f64>>>,
-    surface: Stage<SurfaceKey, Arc<Surface>>,
-    base: Stage<BaseKey, Vec<crate::base_fill::BaseFill>>,
-    toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
+    /// The stages after the shape, lofted or sliced: texture, surface, base, toolpath.
+    later: LaterStages,
+    /// A design from a mesh: the mesh read and placed, its slices, the wall sections from them.
+    mesh: Stage<MeshKey, Arc<crate::stl::Mesh>>,
+    slices: Stage<SliceKey, Arc<crate::mesh::MeshSlices>>,
+    mesh_wall: Stage<MeshWallKey, Vec<Section>>,
+    /// Whether the current design takes its shape from a mesh (the loft stages then say
+    /// nothing: no contours, model or shaped sections).
+    from_mesh: bool,
     /// The design and job of the last successful update.
     design: Option<Design>,
     job: Option<PrintJob>,
@@ -223,8 +265,8 @@ impl Session {
             Ok(_) => {
                 self.error = None;
                 self.job = Some(PrintJob {
-                    surface: self.surface.get().expect("updated").clone(),
-                    toolpath: self.toolpath.get().expect("updated").clone(),
+                    surface: self.later.surface.get().expect("updated").clone(),
+                    toolpath: self.later.toolpath.get().expect("updated").clone(),
                 });
                 if self.design.as_ref() != Some(design)
                     || self.design.as_ref().map(|d| &d.base_dir) != Some(&design.base_dir)
@@ -242,6 +284,11 @@ impl Session {
         let mut done = Update::default();
         let [cx, cy] = design.center();
         let center = DVec2::new(cx, cy);
+        self.from_mesh = design.shape.mesh.is_some();
+        if let Some(source) = &design.shape.mesh {
+            self.update_mesh_stages(design, source, center, &mut done)?;
+            return Ok(done);
+        }
 
         // 1. Contours.
         let specs = [&design.shape.lower, &design.shape.upper];
@@ -332,76 +379,27 @@ impl Session {
         }
         done.sections = dirty;
 
-        // 4. Surface (with the texture's displacements, kept while only the shape changes).
-        if let Some(tex) = &design.texture {
-            let key = TextureKey {
-                texture: tex.clone(),
-                samples: model.loft.samples(),
-                sections: count,
-            };
-            self.texture.refresh(key, || {
-                Ok(crate::texture::displacements(
-                    tex,
-                    model.loft.samples(),
-                    count,
-                ))
-            })?;
-        }
-        let p = &design.printer;
-        let key = SurfaceKey {
-            plan: plan_revision,
-            sections: self.sections_revision,
-            texture: design.texture.clone(),
-            enforce: design.constraints.enforce,
-            max_overhang_deg: p.max_overhang_deg,
-            line_width: p.line_width,
-            bed: (p.bed_shape, p.bed_x, p.bed_y, p.origin),
-            max_z: p.max_z,
-            center_given: design.shape.center.is_some(),
+        let grid = crate::pipeline::SectionGrid {
+            center: model.loft.center,
+            layers: model.layers,
+            layer_pitch: model.layer_pitch,
         };
         let sections = &self.sections;
-        let disp = design
-            .texture
-            .as_ref()
-            .and(self.texture.get())
-            .map(Vec::as_slice);
-        done.surface = self.surface.refresh(key, || {
-            let shaped: Vec<Section> = sections
-                .iter()
-                .map(|s| s.value.clone().unwrap_or_default())
-                .collect();
-            finish_surface(design, model, shaped, plan_findings.clone(), disp).map(Arc::new)
-        })?;
-
-        // 5. Toolpath.
-        let surface = self
-            .surface
-            .get()
-            .cloned()
-            .expect("the surface stage ran above");
-        // The base fill is kept while the feet are the same (an edit higher up the wall).
-        let key = BaseKey {
-            feet: crate::toolpath::base_feet(design, &surface),
-            line_width: p.line_width,
-            wall: (surface.layers, surface.sections[0].points.len()),
-        };
-        self.base
-            .refresh(key, || crate::toolpath::base_fills(design, &surface))?;
-        let key = ToolpathKey {
-            surface: self.surface.revision,
-            base: self.base.revision,
-            base_layers: design.shape.base_layers,
-            line_width: p.line_width,
-            min_layer_height: p.min_layer_height,
-            max_layer_height: p.max_layer_height,
-            min_layer_time: p.min_layer_time,
-            print_speed: p.print_speed,
-            flow_ramp: (p.flow_ramp_start, p.flow_ramp_end),
-        };
-        let fills = self.base.get().expect("the base stage ran above");
-        done.toolpath = self.toolpath.refresh(key, || {
-            build_toolpath_on(design, &surface, fills).map(Arc::new)
-        })?;
+        let surface_inputs = (plan_revision, self.sections_revision);
+        finish_stages(
+            &mut self.later,
+            design,
+            &mut done,
+            grid,
+            surface_inputs,
+            || {
+                sections
+                    .iter()
+                    .map(|s| s.value.clone().unwrap_or_default())
+                    .collect()
+            },
+            plan_findings,
+        )?;
         Ok(done)
     }
 
@@ -430,30 +428,195 @@ impl Session {
         self.updates
     }
 
-    /// The sampled contour `role` (0 lower, 1 upper; see [`CONTOUR_FIELDS`]).
+    /// The sampled contour `role` (0 lower, 1 upper; see [`CONTOUR_FIELDS`]); none for a design
+    /// from a mesh.
     pub fn contour(&self, role: usize) -> Option<&SampledContour> {
+        if self.from_mesh {
+            return None;
+        }
         self.contours.get(role)?.get()
     }
 
-    /// The shape model (loft, control profiles, layer plan) of the current design.
+    /// The shape model (loft, control profiles, layer plan) of the current design; none for a
+    /// design from a mesh.
     pub fn model(&self) -> Option<&ShapeModel> {
+        if self.from_mesh {
+            return None;
+        }
         self.plan.get().map(|(m, _)| m)
     }
 
-    /// Shaped section k (loft and control lines, before correction and texture).
+    /// Shaped section k (loft and control lines, or the mesh's slice, before correction and
+    /// texture).
     pub fn shaped_section(&self, k: usize) -> Option<&Section> {
+        if self.from_mesh {
+            return self.mesh_wall.get()?.get(k);
+        }
         self.sections.get(k)?.get()
     }
 
     /// The corrected, textured surface.
     pub fn surface(&self) -> Option<&Arc<Surface>> {
-        self.surface.get()
+        self.later.surface.get()
     }
 
     /// The spiral toolpath.
     pub fn toolpath(&self) -> Option<&Arc<Toolpath>> {
-        self.toolpath.get()
+        self.later.toolpath.get()
     }
+
+    /// The stages of a design from a mesh: read and place the mesh, slice it at the layer
+    /// heights, make the wall sections, then the stages every design shares.
+    fn update_mesh_stages(
+        &mut self,
+        design: &Design,
+        source: &crate::design::MeshSource,
+        center: DVec2,
+        done: &mut Update,
+    ) -> Result<(), FieldError> {
+        let path = crate::mesh::resolve(source, design.base_dir.as_deref());
+        let stamp = std::fs::metadata(&path)
+            .ok()
+            .and_then(|m| Some((m.modified().ok()?, m.len())));
+        let key = MeshKey {
+            path: path.clone(),
+            stamp,
+            scale: source.scale,
+            rotate_x: source.rotate_x,
+        };
+        done.plan |= self.mesh.refresh(key, || {
+            crate::mesh::load_placed(&path, source).map(Arc::new)
+        })?;
+        let mesh = self.mesh.get().expect("the mesh stage ran above").clone();
+        let key = SliceKey {
+            mesh: self.mesh.revision,
+            layer_height: design.printer.layer_height,
+        };
+        done.plan |= self.slices.refresh(key, || {
+            crate::mesh::slices(&mesh, design.printer.layer_height, &path).map(Arc::new)
+        })?;
+        let slices = self
+            .slices
+            .get()
+            .expect("the slice stage ran above")
+            .clone();
+        let p = &design.printer;
+        let key = MeshWallKey {
+            slices: self.slices.revision,
+            samples: design.shape.samples,
+            line_width: p.line_width,
+            center,
+        };
+        if self.mesh_wall.refresh(key, || {
+            Ok(crate::mesh::wall_sections(
+                &slices.outlines,
+                &slices.heights,
+                design.shape.samples,
+                p.line_width / 2.0,
+            )
+            .into_iter()
+            .map(|s| Section {
+                points: s.points.iter().map(|q| *q + center.extend(0.0)).collect(),
+            })
+            .collect())
+        })? {
+            done.sections = (0..slices.heights.len()).collect();
+        }
+        let grid = crate::pipeline::SectionGrid {
+            center,
+            layers: slices.heights.len() - 1,
+            layer_pitch: slices.pitch,
+        };
+        let wall = self.mesh_wall.get().expect("the wall stage ran above");
+        finish_stages(
+            &mut self.later,
+            design,
+            done,
+            grid,
+            (self.slices.revision, self.mesh_wall.revision),
+            || wall.clone(),
+            &[],
+        )
+    }
+}
+
+/// The stages every design shares once its shaped sections are known: the texture's
+/// displacements, the corrected surface (its key holds the revisions `inputs` of what the
+/// sections came from), the base fill and the toolpath.
+fn finish_stages(
+    later: &mut LaterStages,
+    design: &Design,
+    done: &mut Update,
+    grid: crate::pipeline::SectionGrid,
+    inputs: (u64, u64),
+    shaped: impl FnOnce() -> Vec<Section>,
+    plan_findings: &[Finding],
+) -> Result<(), FieldError> {
+    let count = grid.layers + 1;
+    // 4. Surface (with the texture's displacements, kept while only the shape changes).
+    let samples = design.shape.samples;
+    if let Some(tex) = &design.texture {
+        let key = TextureKey {
+            texture: tex.clone(),
+            samples,
+            sections: count,
+        };
+        later.texture.refresh(key, || {
+            Ok(crate::texture::displacements(tex, samples, count))
+        })?;
+    }
+    let p = &design.printer;
+    let key = SurfaceKey {
+        plan: inputs.0,
+        sections: inputs.1,
+        texture: design.texture.clone(),
+        enforce: design.constraints.enforce,
+        max_overhang_deg: p.max_overhang_deg,
+        line_width: p.line_width,
+        bed: (p.bed_shape, p.bed_x, p.bed_y, p.origin),
+        max_z: p.max_z,
+        center_given: design.shape.center.is_some(),
+    };
+    let disp = design
+        .texture
+        .as_ref()
+        .and(later.texture.get())
+        .map(Vec::as_slice);
+    done.surface = later.surface.refresh(key, || {
+        finish_sections(design, grid, shaped(), plan_findings.to_vec(), disp).map(Arc::new)
+    })?;
+
+    // 5. Toolpath.
+    let surface = later
+        .surface
+        .get()
+        .cloned()
+        .expect("the surface stage ran above");
+    // The base fill is kept while the feet are the same (an edit higher up the wall).
+    let key = BaseKey {
+        feet: crate::toolpath::base_feet(design, &surface),
+        line_width: p.line_width,
+        wall: (surface.layers, surface.sections[0].points.len()),
+    };
+    later
+        .base
+        .refresh(key, || crate::toolpath::base_fills(design, &surface))?;
+    let key = ToolpathKey {
+        surface: later.surface.revision,
+        base: later.base.revision,
+        base_layers: design.shape.base_layers,
+        line_width: p.line_width,
+        min_layer_height: p.min_layer_height,
+        max_layer_height: p.max_layer_height,
+        min_layer_time: p.min_layer_time,
+        print_speed: p.print_speed,
+        flow_ramp: (p.flow_ramp_start, p.flow_ramp_end),
+    };
+    let fills = later.base.get().expect("the base stage ran above");
+    done.toolpath = later.toolpath.refresh(key, || {
+        build_toolpath_on(design, &surface, fills).map(Arc::new)
+    })?;
+    Ok(())
 }
 
 /// Below this many wall points a section batch is shaped on one thread (spawning costs more).

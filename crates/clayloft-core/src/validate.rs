@@ -65,6 +65,18 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64, why: &str) -> Check {
     Ok(())
 }
 
+/// The mesh a design takes its shape from: a path, a positive scale, a turn in degrees.
+fn mesh_source(m: &crate::design::MeshSource) -> Check {
+    if m.path.as_os_str().is_empty() {
+        return Err(FieldError::new(
+            "shape.mesh.path",
+            "is empty: name an STL file",
+        ));
+    }
+    in_range("shape.mesh.scale", m.scale, 1e-4, 1e4, "a factor")?;
+    in_range("shape.mesh.rotate_x", m.rotate_x, -360.0, 360.0, "degrees")
+}
+
 /// Most problems [`validate_all`] lists.
 pub const MAX_REPORTED: usize = 12;
 
@@ -194,24 +206,34 @@ pub fn validate(d: &Design) -> Check {
     validate_printer(&d.printer)?;
     let p = &d.printer;
     let s = &d.shape;
-    fields::check("shape.height", s.height)?;
-    if s.height > p.max_z {
-        return Err(FieldError::new(
-            "shape.height",
-            format!(
-                "{} mm is taller than the printer's build height printer.max_z = {} mm",
-                s.height, p.max_z
-            ),
-        ));
-    }
-    if s.height < p.layer_height {
-        return Err(FieldError::new(
-            "shape.height",
-            format!(
-                "{} mm is less than one layer ({} mm)",
-                s.height, p.layer_height
-            ),
-        ));
+    if let Some(m) = &s.mesh {
+        mesh_source(m)?;
+        if !d.control.vertical.is_empty() || !d.control.horizontal.is_empty() {
+            return Err(FieldError::new(
+                "control",
+                "control lines shape a lofted vessel: a vessel from [shape.mesh] takes its shape from the mesh",
+            ));
+        }
+    } else {
+        fields::check("shape.height", s.height)?;
+        if s.height > p.max_z {
+            return Err(FieldError::new(
+                "shape.height",
+                format!(
+                    "{} mm is taller than the printer's build height printer.max_z = {} mm",
+                    s.height, p.max_z
+                ),
+            ));
+        }
+        if s.height < p.layer_height {
+            return Err(FieldError::new(
+                "shape.height",
+                format!(
+                    "{} mm is less than one layer ({} mm)",
+                    s.height, p.layer_height
+                ),
+            ));
+        }
     }
     if s.samples < 3 || s.samples > MAX_SAMPLES {
         return Err(FieldError::new(
@@ -252,7 +274,7 @@ pub fn validate(d: &Design) -> Check {
         }
     }
     let layers_nominal = s.height / p.layer_height;
-    if s.base_layers as f64 >= layers_nominal {
+    if s.mesh.is_none() && s.base_layers as f64 >= layers_nominal {
         return Err(FieldError::new(
             "shape.base_layers",
             format!(
@@ -261,8 +283,17 @@ pub fn validate(d: &Design) -> Check {
             ),
         ));
     }
-    contour("shape.lower", &s.lower)?;
-    contour("shape.upper", &s.upper)?;
+    if s.mesh.is_none() {
+        for (field, c) in [("shape.lower", &s.lower), ("shape.upper", &s.upper)] {
+            if c.is_missing() {
+                return Err(FieldError::new(
+                    field,
+                    "missing: a design needs a lower and an upper contour, or [shape.mesh]",
+                ));
+            }
+            contour(field, c)?;
+        }
+    }
 
     for (n, line) in d.control.vertical.iter().enumerate() {
         let f = format!("control.vertical[{n}]");

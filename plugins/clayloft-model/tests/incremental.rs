@@ -170,8 +170,14 @@ fn invalid_edit_keeps_the_last_good_surface_and_says_why() {
         .print_speed = -5.0;
     app.update();
     let status = app.world().resource::<ModelStatus>().clone();
-    assert!(status.for_field("printer.layer_height").is_some(), "{status:?}");
-    assert!(status.for_field("printer.print_speed").is_some(), "{status:?}");
+    assert!(
+        status.for_field("printer.layer_height").is_some(),
+        "{status:?}"
+    );
+    assert!(
+        status.for_field("printer.print_speed").is_some(),
+        "{status:?}"
+    );
     app.world_mut()
         .resource_mut::<DesignDoc>()
         .design

@@ -411,7 +411,10 @@ mod tests {
     fn the_constraint_panel_claims_nothing_about_an_edit_it_could_not_build() {
         let mut h = panel(ModelStatus::default());
         h.run();
-        assert!(h.query_by_label("the design keeps every limit as drawn").is_some());
+        assert!(
+            h.query_by_label("the design keeps every limit as drawn")
+                .is_some()
+        );
         let mut h = panel(ModelStatus {
             errors: vec![clayloft_core::validate::FieldError::new(
                 "texture.x.amplitude",
@@ -419,7 +422,13 @@ mod tests {
             )],
         });
         h.run();
-        assert!(h.query_by_label("the design keeps every limit as drawn").is_none());
-        assert!(h.query_by_label_contains("not checked: the design has an error").is_some());
+        assert!(
+            h.query_by_label("the design keeps every limit as drawn")
+                .is_none()
+        );
+        assert!(
+            h.query_by_label_contains("not checked: the design has an error")
+                .is_some()
+        );
     }
 }

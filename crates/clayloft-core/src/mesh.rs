@@ -1,0 +1,659 @@
+//! Vessels from meshes (SPEC §15): a closed triangle mesh (STL, ASCII or binary) sliced at the
+//! layer heights, each slice's outer outline becoming that layer's section.
+//!
+//! - [`parse_stl`] reads the file ([`stl_io`], which merges equal vertices) after checking that a
+//!   binary file is as long as its header says and not absurdly large;
+//! - [`check_closed_body`] refuses what cannot be a vessel: open edges, edges of more than two
+//!   triangles, several bodies, too many triangles without area;
+//! - [`place`] scales, turns about x (Z-up and Y-up exports) and stands the mesh on the bed;
+//! - [`slice_outlines`] cuts it at each height: every triangle that straddles the plane gives one
+//!   segment between two of its edges, and segments chain through the edges they share into
+//!   closed outlines. Outlines inside the outer one (a hollow vessel's inner wall) are left out;
+//!   a second outline beside it (a handle, a second vessel) cannot be one spiral and is refused;
+//! - [`wall_sections`] samples each outline at equal arc length, insets it by half a line width
+//!   (so that the printed bead's outside lies on the model's surface) and turns each section to
+//!   the start that twists least against the one below.
+//!
+//! A vertex exactly on a slicing plane counts as above it, so every straddling triangle crosses
+//! the plane on exactly two edges and the chaining never meets a vertex.
+
+use std::collections::HashMap;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use glam::{DVec2, DVec3};
+
+use crate::design::MeshSource;
+use crate::geometry::{
+    contains_point, dedup_closed, outward_normals, resample_closed, signed_area,
+};
+use crate::sample::min_twist_offset;
+use crate::section::Section;
+use crate::stl::Mesh;
+use crate::validate::FieldError;
+
+/// Most triangles a vessel mesh may have: ten times the 2-million-triangle meshes of a fine
+/// scan, a few GB of working memory; beyond it a file is refused before it is read.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+/// Triangles without area an exporter may leave (slivers at seams): up to 1 % are ignored.
+pub const MAX_DEGENERATE_SHARE: f64 = 0.01;
+/// A triangle whose area is below this is degenerate, mm².
+const DEGENERATE_AREA: f64 = 1e-9;
+/// Outlines smaller than this beside the outer one are slicing noise, not a second body, mm².
+const NOISE_AREA: f64 = 1.0;
+
+/// What is wrong with a mesh, in words for the one-line message that names the file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    #[error("not an STL file: {0}")]
+    Read(String),
+    #[error(
+        "truncated: the header announces {declared} triangles ({need} bytes), the file has {got} bytes"
+    )]
+    Truncated { declared: u64, need: u64, got: u64 },
+    #[error("{0} triangles: more than the {MAX_TRIANGLES} a vessel mesh may have")]
+    TooLarge(u64),
+    #[error("no triangles")]
+    Empty,
+    #[error(
+        "not closed: {open} edges belong to one triangle only (one near x = {:.1}, y = {:.1}, z = {:.1} mm): a vessel mesh must be watertight",
+        at[0], at[1], at[2]
+    )]
+    NotClosed { open: usize, at: [f64; 3] },
+    #[error(
+        "not a simple surface: {0} edges are shared by more than two triangles (touching bodies or doubled faces)"
+    )]
+    NonManifold(usize),
+    #[error("{0} separate bodies: a vessel mesh is one closed body")]
+    SeveralBodies(usize),
+    #[error("{bad} of {total} triangles have no area (more than 1 %): the mesh is broken")]
+    Degenerate { bad: usize, total: usize },
+    #[error(
+        "the slice at z = {z:.2} mm has {outlines} separate outlines (a handle, or a second vessel beside the first): one spiral can follow only one"
+    )]
+    SeveralOutlines { z: f64, outlines: usize },
+    #[error("the slice at z = {z:.2} mm is empty: the mesh does not reach that height")]
+    EmptySlice { z: f64 },
+    #[error("{0}")]
+    Size(String),
+}
+
+/// Reads an STL file's bytes (ASCII or binary) into a mesh with shared vertices.
+pub fn parse_stl(bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let ascii = bytes.trim_ascii_start().starts_with(b"solid") && is_probably_text(bytes);
+    if !ascii {
+        if bytes.len() < 84 {
+            return Err(MeshError::Read(format!(
+                "{} bytes, shorter than a binary STL header (84 bytes)",
+                bytes.len()
+            )));
+        }
+        let declared = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        if declared > MAX_TRIANGLES as u64 {
+            return Err(MeshError::TooLarge(declared));
+        }
+        let need = 84 + 50 * declared;
+        if (bytes.len() as u64) < need {
+            return Err(MeshError::Truncated {
+                declared,
+                need,
+                got: bytes.len() as u64,
+            });
+        }
+    } else if bytes.len() / 100 > MAX_TRIANGLES {
+        // An ASCII facet is at least ~150 bytes.
+        return Err(MeshError::TooLarge((bytes.len() / 150) as u64));
+    }
+    let indexed = stl_io::read_stl(&mut Cursor::new(bytes)).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::UnexpectedEof {
+            MeshError::Read("it ends in the middle of a triangle".into())
+        } else {
+            MeshError::Read(e.to_string())
+        }
+    })?;
+    if indexed.faces.is_empty() {
+        return Err(MeshError::Empty);
+    }
+    if indexed.faces.len() > MAX_TRIANGLES {
+        return Err(MeshError::TooLarge(indexed.faces.len() as u64));
+    }
+    let vertices: Vec<DVec3> = indexed
+        .vertices
+        .iter()
+        .map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+        .collect();
+    if let Some(bad) = vertices.iter().find(|v| !v.is_finite()) {
+        return Err(MeshError::Read(format!("a vertex is not a number: {bad}")));
+    }
+    let triangles = indexed
+        .faces
+        .iter()
+        .map(|f| f.vertices.map(|i| i as u32))
+        .collect();
+    Ok(Mesh {
+        vertices,
+        triangles,
+    })
+}
+
+/// Whether the first kilobyte looks like text (an ASCII STL), not a binary header that happens
+/// to begin with "solid" (several exporters write that).
+fn is_probably_text(bytes: &[u8]) -> bool {
+    bytes
+        .iter()
+        .take(1024)
+        .all(|&b| b.is_ascii_graphic() || b.is_ascii_whitespace())
+}
+
+/// The twice-area of a triangle, mm².
+fn twice_area(m: &Mesh, t: &[u32; 3]) -> f64 {
+    let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+    (b - a).cross(c - a).length()
+}
+
+/// An undirected edge between two vertices, as one number.
+fn edge_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    ((lo as u64) << 32) | hi as u64
+}
+
+/// Checks that the mesh is one closed body: every edge shared by exactly two triangles (of those
+/// with area), one connected piece, and at most [`MAX_DEGENERATE_SHARE`] of triangles without
+/// area (which are then ignored). Returns the mesh without the degenerate triangles.
+pub fn check_closed_body(mesh: &Mesh) -> Result<Mesh, MeshError> {
+    let total = mesh.triangles.len();
+    if total == 0 {
+        return Err(MeshError::Empty);
+    }
+    let kept: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .copied()
+        .filter(|t| twice_area(mesh, t) > 2.0 * DEGENERATE_AREA)
+        .collect();
+    let bad = total - kept.len();
+    if bad as f64 > MAX_DEGENERATE_SHARE * total as f64 {
+        return Err(MeshError::Degenerate { bad, total });
+    }
+    // Edge → the triangles on it.
+    let mut edges: HashMap<u64, (u32, u32, u8)> = HashMap::with_capacity(kept.len() * 3 / 2);
+    for (ti, t) in kept.iter().enumerate() {
+        for e in 0..3 {
+            let key = edge_key(t[e], t[(e + 1) % 3]);
+            let slot = edges.entry(key).or_insert((ti as u32, u32::MAX, 0));
+            if slot.2 == 1 {
+                slot.1 = ti as u32;
+            }
+            slot.2 = slot.2.saturating_add(1);
+        }
+    }
+    let open: Vec<u64> = edges
+        .iter()
+        .filter(|(_, s)| s.2 == 1)
+        .map(|(k, _)| *k)
+        .collect();
+    if let Some(&first) = open.iter().min() {
+        let p = mesh.vertices[(first >> 32) as usize];
+        return Err(MeshError::NotClosed {
+            open: open.len(),
+            at: [p.x, p.y, p.z],
+        });
+    }
+    let shared = edges.values().filter(|s| s.2 > 2).count();
+    if shared > 0 {
+        return Err(MeshError::NonManifold(shared));
+    }
+    // Connected pieces, by union–find over the triangles sharing an edge.
+    let mut parent: Vec<u32> = (0..kept.len() as u32).collect();
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
+        }
+        i
+    }
+    for s in edges.values() {
+        let (a, b) = (root(&mut parent, s.0), root(&mut parent, s.1));
+        if a != b {
+            parent[a as usize] = b;
+        }
+    }
+    let bodies = (0..kept.len() as u32)
+        .filter(|&i| root(&mut parent, i) == i)
+        .count();
+    if bodies > 1 {
+        return Err(MeshError::SeveralBodies(bodies));
+    }
+    Ok(Mesh {
+        vertices: mesh.vertices.clone(),
+        triangles: kept,
+    })
+}
+
+/// The mesh scaled by `scale`, turned by `rotate_x_deg` about the x axis (90 stands a Y-up
+/// export upright), and moved so that it stands on z = 0 with its footprint's bounding box
+/// centred on the origin.
+pub fn place(mesh: &Mesh, scale: f64, rotate_x_deg: f64) -> Mesh {
+    let (s, c) = rotate_x_deg.to_radians().sin_cos();
+    let mut vertices: Vec<DVec3> = mesh
+        .vertices
+        .iter()
+        .map(|v| {
+            let v = *v * scale;
+            DVec3::new(v.x, c * v.y - s * v.z, s * v.y + c * v.z)
+        })
+        .collect();
+    let (lo, hi) = vertices.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+    );
+    let shift = DVec3::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0, lo.z);
+    for v in &mut vertices {
+        *v -= shift;
+    }
+    Mesh {
+        vertices,
+        triangles: mesh.triangles.clone(),
+    }
+}
+
+/// Lowest and highest z of the mesh.
+pub fn z_range(mesh: &Mesh) -> (f64, f64) {
+    mesh.vertices
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v.z), hi.max(v.z))
+        })
+}
+
+/// The outer outline (counter-clockwise) of the mesh at each of `heights` (ascending).
+pub fn slice_outlines(mesh: &Mesh, heights: &[f64]) -> Result<Vec<Vec<DVec2>>, MeshError> {
+    // Each triangle goes to the planes its z-range straddles.
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); heights.len()];
+    for (ti, t) in mesh.triangles.iter().enumerate() {
+        let zs = t.map(|i| mesh.vertices[i as usize].z);
+        let (lo, hi) = (zs[0].min(zs[1]).min(zs[2]), zs[0].max(zs[1]).max(zs[2]));
+        // Planes h with lo < h ≤ hi (a vertex on a plane counts as above it).
+        let first = heights.partition_point(|&h| h <= lo);
+        let last = heights.partition_point(|&h| h <= hi);
+        for bucket in &mut buckets[first..last] {
+            bucket.push(ti as u32);
+        }
+    }
+    let outlines = crate::parallel::map_ranges(heights.len(), 8, |range| {
+        range
+            .map(|k| outline_at(mesh, &buckets[k], heights[k]))
+            .collect()
+    });
+    outlines.into_iter().collect()
+}
+
+/// The outer outline of the plane z = `h` through the triangles `tris` that straddle it.
+fn outline_at(mesh: &Mesh, tris: &[u32], h: f64) -> Result<Vec<DVec2>, MeshError> {
+    // Every straddling triangle crosses the plane on two edges: one segment between them.
+    let mut segments: Vec<[u64; 2]> = Vec::with_capacity(tris.len());
+    let mut points: HashMap<u64, DVec2> = HashMap::with_capacity(tris.len());
+    for &ti in tris {
+        let t = mesh.triangles[ti as usize];
+        let mut ends = [0u64; 2];
+        let mut found = 0;
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            let (pa, pb) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
+            if (pa.z >= h) != (pb.z >= h) && found < 2 {
+                let key = edge_key(a, b);
+                let f = (h - pa.z) / (pb.z - pa.z);
+                points
+                    .entry(key)
+                    .or_insert_with(|| pa.truncate().lerp(pb.truncate(), f));
+                ends[found] = key;
+                found += 1;
+            }
+        }
+        if found == 2 {
+            segments.push(ends);
+        }
+    }
+    if segments.is_empty() {
+        return Err(MeshError::EmptySlice { z: h });
+    }
+    // Chain the segments through the edges they share (each edge is on two of them).
+    let mut by_edge: HashMap<u64, [u32; 2]> = HashMap::with_capacity(segments.len());
+    for (si, s) in segments.iter().enumerate() {
+        for &e in s {
+            let slot = by_edge.entry(e).or_insert([u32::MAX; 2]);
+            if slot[0] == u32::MAX {
+                slot[0] = si as u32;
+            } else {
+                slot[1] = si as u32;
+            }
+        }
+    }
+    let mut used = vec![false; segments.len()];
+    let mut outlines: Vec<Vec<DVec2>> = Vec::new();
+    for start in 0..segments.len() {
+        if used[start] {
+            continue;
+        }
+        let mut outline = Vec::new();
+        let (mut seg, mut edge) = (start, segments[start][1]);
+        used[start] = true;
+        outline.push(points[&segments[start][0]]);
+        loop {
+            outline.push(points[&edge]);
+            let next = by_edge[&edge]
+                .into_iter()
+                .find(|&s| s != u32::MAX && s as usize != seg);
+            match next {
+                Some(s) if !used[s as usize] => {
+                    seg = s as usize;
+                    used[seg] = true;
+                    let [a, b] = segments[seg];
+                    edge = if a == edge { b } else { a };
+                }
+                _ => break,
+            }
+        }
+        let outline = dedup_closed(&outline);
+        if outline.len() >= 3 {
+            outlines.push(outline);
+        }
+    }
+    let outer = outlines
+        .iter()
+        .enumerate()
+        .max_by(|a, b| signed_area(a.1).abs().total_cmp(&signed_area(b.1).abs()))
+        .map(|(i, _)| i)
+        .ok_or(MeshError::EmptySlice { z: h })?;
+    let beside = outlines
+        .iter()
+        .enumerate()
+        .filter(|&(i, o)| {
+            i != outer
+                && signed_area(o).abs() > NOISE_AREA
+                && !contains_point(&outlines[outer], o[0])
+        })
+        .count();
+    if beside > 0 {
+        return Err(MeshError::SeveralOutlines {
+            z: h,
+            outlines: beside + 1,
+        });
+    }
+    let mut outline = outlines.swap_remove(outer);
+    if signed_area(&outline) < 0.0 {
+        outline.reverse();
+    }
+    Ok(outline)
+}
+
+/// The wall sections from the outlines at `heights`: `samples` points at equal arc length, inset
+/// by `inset` along the outward normal, each turned to the start that twists least against the
+/// one below; section 0 lies on the bed (z = 0).
+pub fn wall_sections(
+    outlines: &[Vec<DVec2>],
+    heights: &[f64],
+    samples: usize,
+    inset: f64,
+) -> Vec<Section> {
+    let mut sections: Vec<Section> = Vec::with_capacity(outlines.len());
+    let mut below: Option<Vec<DVec2>> = None;
+    for (k, (outline, &h)) in outlines.iter().zip(heights).enumerate() {
+        let ring = resample_closed(outline, samples);
+        let normals = outward_normals(&ring);
+        let mut xy: Vec<DVec2> = ring
+            .iter()
+            .zip(&normals)
+            .map(|(p, n)| *p - *n * inset)
+            .collect();
+        if let Some(prev) = &below {
+            let o = min_twist_offset(prev, &xy);
+            xy.rotate_left(o);
+        }
+        let z = if k == 0 { 0.0 } else { h };
+        sections.push(Section {
+            points: xy.iter().map(|p| p.extend(z)).collect(),
+        });
+        below = Some(xy);
+    }
+    sections
+}
+
+/// A placed mesh cut at the layer heights: the outer outline at each, and the pitch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshSlices {
+    pub outlines: Vec<Vec<DVec2>>,
+    pub heights: Vec<f64>,
+    pub pitch: f64,
+}
+
+/// The mesh file of `source`, relative to the design's folder `base`.
+pub fn resolve(source: &MeshSource, base: Option<&Path>) -> PathBuf {
+    match base {
+        Some(b) if source.path.is_relative() => b.join(&source.path),
+        _ => source.path.clone(),
+    }
+}
+
+/// A problem with the mesh file at `path`, as the design's error on `shape.mesh.path`.
+fn mesh_field_error(path: &Path, e: impl std::fmt::Display) -> FieldError {
+    FieldError::new("shape.mesh.path", format!("{}: {e}", path.display()))
+}
+
+/// Reads the mesh file at `path`, checks it is one closed body and places it as `source` says.
+pub fn load_placed(path: &Path, source: &MeshSource) -> Result<Mesh, FieldError> {
+    let len = std::fs::metadata(path)
+        .map_err(|e| mesh_field_error(path, format!("cannot read: {e}")))?
+        .len();
+    // 84 bytes of header and 50 per triangle, or ~150 per ASCII facet.
+    if len > 84 + 200 * MAX_TRIANGLES as u64 {
+        return Err(mesh_field_error(path, MeshError::TooLarge(len / 50)));
+    }
+    let bytes =
+        std::fs::read(path).map_err(|e| mesh_field_error(path, format!("cannot read: {e}")))?;
+    let mesh = parse_stl(&bytes).map_err(|e| mesh_field_error(path, e))?;
+    let mesh = check_closed_body(&mesh).map_err(|e| mesh_field_error(path, e))?;
+    Ok(place(&mesh, source.scale, source.rotate_x))
+}
+
+/// The placed mesh cut into layers of about `layer_height` ([`layer_heights`]).
+pub fn slices(mesh: &Mesh, layer_height: f64, path: &Path) -> Result<MeshSlices, FieldError> {
+    let (_, top) = z_range(mesh);
+    if !(top > layer_height) {
+        return Err(mesh_field_error(
+            path,
+            format!("{top:.3} mm tall: less than one layer ({layer_height} mm)"),
+        ));
+    }
+    let layers = top / layer_height;
+    if layers > 1e5 {
+        return Err(mesh_field_error(
+            path,
+            format!(
+                "{top:.0} mm tall: {layers:.0} layers of {layer_height} mm (check shape.mesh.scale)"
+            ),
+        ));
+    }
+    let (heights, pitch) = layer_heights(top, layer_height);
+    let outlines = slice_outlines(mesh, &heights).map_err(|e| mesh_field_error(path, e))?;
+    Ok(MeshSlices {
+        outlines,
+        heights,
+        pitch,
+    })
+}
+
+/// The heights a mesh `height` mm tall is sliced at for layers of about `layer_height`: L layers
+/// of `height / L`, section 0 just above the bed and the last just below the top (a plane
+/// through the very bottom or top face would cut nothing). Returns the heights and the pitch.
+pub fn layer_heights(height: f64, layer_height: f64) -> (Vec<f64>, f64) {
+    let layers = ((height / layer_height).round() as usize).max(1);
+    let pitch = height / layers as f64;
+    let eps = (pitch * 1e-3).min(1e-3);
+    let heights = (0..=layers)
+        .map(|k| (k as f64 * pitch).clamp(eps, height - eps))
+        .collect();
+    (heights, pitch)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed cylinder of `n` sides, radius r, height h, centred on the origin.
+    pub(crate) fn cylinder(n: usize, r: f64, h: f64) -> Mesh {
+        let mut m = Mesh::default();
+        for z in [0.0, h] {
+            for i in 0..n {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                m.vertices.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+            }
+        }
+        m.vertices.push(DVec3::new(0.0, 0.0, 0.0));
+        m.vertices.push(DVec3::new(0.0, 0.0, h));
+        let (bc, tc) = (2 * n as u32, 2 * n as u32 + 1);
+        for i in 0..n as u32 {
+            let j = (i + 1) % n as u32;
+            let (b0, b1, t0, t1) = (i, j, i + n as u32, j + n as u32);
+            m.triangles.push([b0, b1, t1]);
+            m.triangles.push([b0, t1, t0]);
+            m.triangles.push([bc, b1, b0]);
+            m.triangles.push([tc, t0, t1]);
+        }
+        m
+    }
+
+    #[test]
+    fn a_cylinder_slices_to_its_circle() {
+        let m = check_closed_body(&cylinder(64, 30.0, 50.0)).unwrap();
+        let (heights, pitch) = layer_heights(50.0, 2.0);
+        assert_eq!((heights.len(), pitch), (26, 2.0));
+        let outlines = slice_outlines(&m, &heights).unwrap();
+        for o in &outlines {
+            assert!(signed_area(o) > 0.0, "counter-clockwise");
+            for p in o {
+                // On the 64-gon: between its inscribed and circumscribed radius.
+                let r = p.length();
+                assert!(r <= 30.0 + 1e-9 && r >= 30.0 * (std::f64::consts::PI / 64.0).cos() - 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn broken_meshes_are_refused_with_the_reason() {
+        let m = cylinder(16, 20.0, 30.0);
+        // An open mesh: one triangle taken away.
+        let mut open = m.clone();
+        open.triangles.pop();
+        assert!(matches!(
+            check_closed_body(&open),
+            Err(MeshError::NotClosed { open: 3, .. })
+        ));
+        // Two bodies.
+        let mut two = m.clone();
+        let offset = two.vertices.len() as u32;
+        let other = cylinder(16, 20.0, 30.0);
+        two.vertices.extend(
+            other
+                .vertices
+                .iter()
+                .map(|v| *v + DVec3::new(100.0, 0.0, 0.0)),
+        );
+        two.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| i + offset)));
+        assert_eq!(check_closed_body(&two), Err(MeshError::SeveralBodies(2)));
+        // …which slice into two outlines side by side.
+        let err = slice_outlines(&two, &[10.0]).unwrap_err();
+        assert!(
+            matches!(err, MeshError::SeveralOutlines { outlines: 2, .. }),
+            "{err}"
+        );
+        // A doubled face.
+        let mut doubled = m.clone();
+        doubled.triangles.push(m.triangles[0]);
+        assert!(matches!(
+            check_closed_body(&doubled),
+            Err(MeshError::NonManifold(_))
+        ));
+        // Many triangles without area.
+        let mut slivers = m.clone();
+        for _ in 0..10 {
+            slivers.triangles.push([0, 0, 1]);
+        }
+        assert!(matches!(
+            check_closed_body(&slivers),
+            Err(MeshError::Degenerate { bad: 10, .. })
+        ));
+        // A few are tolerated and left out.
+        let mut few = cylinder(200, 20.0, 30.0);
+        few.triangles.push([0, 0, 1]);
+        assert_eq!(check_closed_body(&few).unwrap().triangles.len(), 800);
+    }
+
+    #[test]
+    fn a_hollow_vessel_keeps_its_outer_wall() {
+        // A thick-walled tube: outer and inner cylinders joined at top and bottom by annuli.
+        let (n, ro, ri, h) = (48u32, 30.0, 26.0, 40.0);
+        let mut m = Mesh::default();
+        for (r, z) in [(ro, 0.0), (ro, h), (ri, 0.0), (ri, h)] {
+            for i in 0..n {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                m.vertices.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+            }
+        }
+        let ring = |k: u32, i: u32| k * n + i % n;
+        for i in 0..n {
+            let j = i + 1;
+            // outer wall (outward), inner wall (inward), bottom and top annuli.
+            m.triangles.push([ring(0, i), ring(0, j), ring(1, j)]);
+            m.triangles.push([ring(0, i), ring(1, j), ring(1, i)]);
+            m.triangles.push([ring(2, i), ring(3, j), ring(2, j)]);
+            m.triangles.push([ring(2, i), ring(3, i), ring(3, j)]);
+            m.triangles.push([ring(0, i), ring(2, j), ring(0, j)]);
+            m.triangles.push([ring(0, i), ring(2, i), ring(2, j)]);
+            m.triangles.push([ring(1, i), ring(1, j), ring(3, j)]);
+            m.triangles.push([ring(1, i), ring(3, j), ring(3, i)]);
+        }
+        let m = check_closed_body(&m).unwrap();
+        let outlines = slice_outlines(&m, &[20.0]).unwrap();
+        let r = outlines[0].iter().map(|p| p.length()).fold(0.0, f64::max);
+        assert!((r - ro).abs() < 1e-9, "the outer wall: {r}");
+    }
+
+    #[test]
+    fn truncated_and_absurd_files_are_refused_before_reading() {
+        let mut bytes = vec![0u8; 84];
+        bytes[80..84].copy_from_slice(&1000u32.to_le_bytes());
+        bytes.extend(vec![0u8; 50 * 999]);
+        assert!(matches!(
+            parse_stl(&bytes),
+            Err(MeshError::Truncated { declared: 1000, .. })
+        ));
+        bytes[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(matches!(parse_stl(&bytes), Err(MeshError::TooLarge(_))));
+        assert!(matches!(
+            parse_stl(b"solid x\nfacet normal 0 0 1\n outer loop\n vertex 0 0 0\n"),
+            Err(MeshError::Read(_))
+        ));
+        assert!(matches!(parse_stl(&[1, 2, 3]), Err(MeshError::Read(_))));
+        assert!(matches!(
+            parse_stl(b"solid empty\nendsolid empty\n"),
+            Err(MeshError::Empty)
+        ));
+    }
+
+    #[test]
+    fn binary_and_ascii_files_read_the_same_mesh() {
+        let m = cylinder(12, 10.0, 20.0);
+        let mut binary = Vec::new();
+        crate::stl::write_binary_stl(&m, "cyl", &mut binary).unwrap();
+        let mut ascii = Vec::new();
+        crate::stl::write_ascii_stl(&m, "cyl", &mut ascii).unwrap();
+        let (a, b) = (parse_stl(&binary).unwrap(), parse_stl(&ascii).unwrap());
+        assert_eq!(a.triangles.len(), m.triangles.len());
+        assert_eq!(a.vertices.len(), m.vertices.len(), "equal vertices merged");
+        assert_eq!(a.triangles.len(), b.triangles.len());
+        check_closed_body(&a).unwrap();
+        check_closed_body(&b).unwrap();
+    }
+}
