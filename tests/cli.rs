@@ -712,3 +712,152 @@ fn flow_channel_shows_the_plug_of_a_yield_stress_slurry() {
     ]);
     assert_bad_input(&out, &["--threads 0"]);
 }
+
+/// A closed solid of revolution as binary STL bytes: `n` around, `rings` from 0 to `h`.
+fn revolution_stl(n: usize, rings: usize, h: f32, r: impl Fn(f32) -> f32) -> Vec<u8> {
+    let mut v = Vec::new();
+    for k in 0..rings {
+        let z = h * k as f32 / (rings - 1) as f32;
+        for i in 0..n {
+            let a = std::f32::consts::TAU * i as f32 / n as f32;
+            v.push([r(z) * a.cos(), r(z) * a.sin(), z]);
+        }
+    }
+    let (bottom, top) = (v.len(), v.len() + 1);
+    v.push([0.0, 0.0, 0.0]);
+    v.push([0.0, 0.0, h]);
+    let at = |k: usize, i: usize| k * n + i % n;
+    let mut t = Vec::new();
+    for k in 0..rings - 1 {
+        for i in 0..n {
+            t.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
+            t.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
+        }
+    }
+    for i in 0..n {
+        t.push([bottom, at(0, i + 1), at(0, i)]);
+        t.push([top, at(rings - 1, i), at(rings - 1, i + 1)]);
+    }
+    let mut bytes = vec![b' '; 80];
+    bytes.extend((t.len() as u32).to_le_bytes());
+    for tri in &t {
+        bytes.extend([0u8; 12]);
+        for &i in tri {
+            for c in v[i] {
+                bytes.extend(c.to_le_bytes());
+            }
+        }
+        bytes.extend([0u8; 2]);
+    }
+    bytes
+}
+
+#[test]
+fn a_mesh_prints_directly_and_from_a_design_that_names_it() {
+    let dir = tempfile::tempdir().unwrap();
+    // The shipped example, straight from the command line with the default printer.
+    let gcode = dir.path().join("lobed.gcode");
+    let mesh = "assets/meshes/lobed-vase.stl";
+    let out = clayloft(&["gcode", mesh, "-o", gcode.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains("layers: 90"),
+        "{}",
+        text(&out.stdout)
+    );
+    let check = clayloft(&["check", gcode.to_str().unwrap()]);
+    assert!(
+        text(&check.stdout).contains("all limits hold"),
+        "{}",
+        text(&check.stdout)
+    );
+    // A design file naming a mesh, turned and scaled: a vase modelled in centimetres, y up.
+    std::fs::write(
+        dir.path().join("tall.stl"),
+        revolution_stl(64, 11, 8.0, |z| {
+            3.0 + 0.5 * (z / 8.0 * std::f32::consts::PI).sin()
+        }),
+    )
+    .unwrap();
+    let design = dir.path().join("tall.toml");
+    std::fs::write(
+        &design,
+        "version = 1\nname = \"tall\"\n[shape]\nbase_layers = 3\n[shape.mesh]\npath = \"tall.stl\"\nscale = 10.0\nrotate_x = 0.0\n[texture]\ncombine = \"sum\"\nx = { wave = \"sine\", period = 20.0, amplitude = 0.8 }\n",
+    )
+    .unwrap();
+    let out = clayloft(&[
+        "gcode",
+        design.to_str().unwrap(),
+        "-o",
+        gcode.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains("layers: 80"),
+        "{}",
+        text(&out.stdout)
+    );
+    let stl = dir.path().join("again.stl");
+    let out = clayloft(&["stl", design.to_str().unwrap(), "-o", stl.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+#[test]
+fn bad_meshes_exit_2_naming_the_file_and_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let gcode = dir.path().join("out.gcode");
+    let good = revolution_stl(32, 5, 40.0, |_| 20.0);
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("cut.stl", good[..good.len() - 20].to_vec(), "truncated"),
+        (
+            "open.stl",
+            {
+                let mut b = good.clone();
+                let n = u32::from_le_bytes([b[80], b[81], b[82], b[83]]) - 1;
+                b[80..84].copy_from_slice(&n.to_le_bytes());
+                b.truncate(84 + 50 * n as usize);
+                b
+            },
+            "not closed",
+        ),
+        (
+            "two.stl",
+            {
+                // The same body twice, side by side.
+                let other = revolution_stl(32, 5, 40.0, |_| 20.0);
+                let mut b = good.clone();
+                let n = u32::from_le_bytes([b[80], b[81], b[82], b[83]]);
+                b[80..84].copy_from_slice(&(2 * n).to_le_bytes());
+                for tri in other[84..].chunks(50) {
+                    let mut t = tri.to_vec();
+                    for v in 0..3 {
+                        let x = 12 + 12 * v;
+                        let moved = f32::from_le_bytes([t[x], t[x + 1], t[x + 2], t[x + 3]]) + 60.0;
+                        t[x..x + 4].copy_from_slice(&moved.to_le_bytes());
+                    }
+                    b.extend(t);
+                }
+                b
+            },
+            "separate bodies",
+        ),
+        ("huge.stl", revolution_stl(32, 5, 40.0, |_| 900.0), "bed"),
+        (
+            "text.stl",
+            b"solid x\nfacet normal 0 0 1\n outer loop\n vertex 0 0 0\n".to_vec(),
+            "not an STL",
+        ),
+    ];
+    for (name, bytes, needle) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let out = clayloft(&[
+            "gcode",
+            path.to_str().unwrap(),
+            "-o",
+            gcode.to_str().unwrap(),
+        ]);
+        assert_bad_input(&out, &[name, needle]);
+        assert!(!gcode.exists(), "{name}: no output file");
+    }
+}

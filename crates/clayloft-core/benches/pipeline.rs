@@ -121,5 +121,54 @@ fn gcode_writing(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, pipeline, base_fill, gcode_writing);
+/// A closed vessel of revolution with `n` points round and `rings` rings up to 300 mm: 2·n·rings
+/// triangles, about a million for n = 1000, rings = 500.
+fn revolution_mesh(n: usize, rings: usize) -> clayloft_core::stl::Mesh {
+    use glam::DVec3;
+    let h = 300.0;
+    let mut m = clayloft_core::stl::Mesh::default();
+    for k in 0..rings {
+        let z = h * k as f64 / (rings - 1) as f64;
+        let r = 60.0 + 15.0 * (std::f64::consts::PI * z / h).sin();
+        for i in 0..n {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            m.vertices.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+        }
+    }
+    let (bottom, top) = (m.vertices.len() as u32, m.vertices.len() as u32 + 1);
+    m.vertices.push(DVec3::ZERO);
+    m.vertices.push(DVec3::new(0.0, 0.0, h));
+    let at = |k: usize, i: usize| (k * n + i % n) as u32;
+    for k in 0..rings - 1 {
+        for i in 0..n {
+            m.triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
+            m.triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
+        }
+    }
+    for i in 0..n {
+        m.triangles.push([bottom, at(0, i + 1), at(0, i)]);
+        m.triangles
+            .push([top, at(rings - 1, i), at(rings - 1, i + 1)]);
+    }
+    m
+}
+
+/// Slicing a million-triangle vessel into 300 layers (issue 16), and checking it is one closed
+/// body first.
+fn mesh_slicing(c: &mut Criterion) {
+    use clayloft_core::mesh::{check_closed_body, layer_heights, slice_outlines};
+    let mesh = revolution_mesh(1000, 501);
+    let (heights, _) = layer_heights(300.0, 1.0);
+    let mut g = c.benchmark_group("mesh");
+    g.sample_size(10);
+    g.bench_function("check_1M_triangles", |b| {
+        b.iter(|| black_box(check_closed_body(&mesh).unwrap().triangles.len()))
+    });
+    g.bench_function("slice_1M_triangles_300_layers", |b| {
+        b.iter(|| black_box(slice_outlines(&mesh, &heights).unwrap().len()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, pipeline, base_fill, gcode_writing, mesh_slicing);
 criterion_main!(benches);

@@ -60,6 +60,12 @@ impl Design {
                 *path = rebased.to_string_lossy().replace('\\', "/");
             }
         }
+        if let Some(mesh) = &mut moved.shape.mesh
+            && mesh.path.is_relative()
+        {
+            let target = from.join(&mesh.path);
+            mesh.path = pathdiff::diff_paths(&target, &to).unwrap_or(target);
+        }
         moved
     }
 }

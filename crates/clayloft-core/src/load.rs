@@ -28,6 +28,9 @@ pub enum DesignError {
         field: String,
         message: String,
     },
+    /// A mesh opened on its own (`clayloft gcode vase.stl`): what is wrong with it or its print.
+    #[error("{file}: {message}")]
+    Mesh { file: String, message: String },
 }
 
 /// A parsed and validated design together with its source text, kept so that later problems
@@ -42,8 +45,50 @@ pub struct LoadedDesign {
 impl LoadedDesign {
     /// Turns a field problem found after loading into a located error for this file.
     pub fn locate(&self, err: FieldError) -> DesignError {
+        if is_mesh_file(&self.path) {
+            return mesh_error(&self.path, err);
+        }
         located(&self.path, &self.source, err)
     }
+}
+
+/// Whether `path` names a mesh (an STL or OBJ file), which opens as a design of its own.
+pub fn is_mesh_file(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("stl") || e.eq_ignore_ascii_case("obj"))
+}
+
+/// A problem of a mesh opened on its own: the mesh's own ones without the repeated path, the
+/// others (a vessel too large for the bed) with their field.
+fn mesh_error(path: &Path, err: FieldError) -> DesignError {
+    let file = path.display().to_string();
+    let message = match err.message.strip_prefix(&format!("{file}: ")) {
+        Some(own) => own.to_string(),
+        None => format!("{}: {}", err.field, err.message),
+    };
+    DesignError::Mesh { file, message }
+}
+
+/// The design of a mesh file opened on its own: its shape from the mesh, everything else the
+/// defaults (the paper's printer) or printer profile `printer`.
+fn mesh_as_design(path: &Path, printer: Option<&str>) -> Result<LoadedDesign, DesignError> {
+    let mut doc = toml_edit::DocumentMut::new();
+    doc["version"] = toml_edit::value(i64::from(crate::design::DESIGN_VERSION));
+    let stem = path.file_stem().map(|s| s.to_string_lossy().to_string());
+    doc["name"] = toml_edit::value(stem.unwrap_or_else(|| "mesh".into()));
+    let mut mesh = toml_edit::Table::new();
+    let file_name = path.file_name().map(|s| s.to_string_lossy().to_string());
+    mesh["path"] = toml_edit::value(file_name.unwrap_or_default());
+    let mut shape = toml_edit::Table::new();
+    shape.set_implicit(true);
+    shape.insert("mesh", toml_edit::Item::Table(mesh));
+    doc.insert("shape", toml_edit::Item::Table(shape));
+    load_design_text_using(path, doc.to_string(), printer).map_err(|e| match e {
+        DesignError::Field { field, message, .. } => {
+            mesh_error(path, FieldError::new(field, message))
+        }
+        other => other,
+    })
 }
 
 /// Reads, parses and validates a design file (with the printer profile it names, if any).
@@ -54,6 +99,9 @@ pub fn load_design(path: &Path) -> Result<LoadedDesign, DesignError> {
 /// As [`load_design`], with printer profile `printer` (a shipped name or a profile file) in
 /// place of the one the design names (`clayloft gcode --printer`).
 pub fn load_design_using(path: &Path, printer: Option<&str>) -> Result<LoadedDesign, DesignError> {
+    if is_mesh_file(path) {
+        return mesh_as_design(path, printer);
+    }
     let file = path.display().to_string();
     let read_err = |reason: String| DesignError::Read {
         file: file.clone(),

@@ -1,8 +1,9 @@
-//! Vessels from meshes (SPEC §15): a closed triangle mesh (STL, ASCII or binary) sliced at the
-//! layer heights, each slice's outer outline becoming that layer's section.
+//! Vessels from meshes (SPEC §15): a closed triangle mesh (STL, ASCII or binary, or Wavefront
+//! OBJ) sliced at the layer heights, each slice's outer outline becoming that layer's section.
 //!
 //! - [`parse_stl`] reads the file ([`stl_io`], which merges equal vertices) after checking that a
-//!   binary file is as long as its header says and not absurdly large;
+//!   binary file is as long as its header says and not absurdly large; [`parse_obj`] reads OBJ
+//!   ([`tobj`]);
 //! - [`check_closed_body`] refuses what cannot be a vessel: open edges, edges of more than two
 //!   triangles, several bodies, too many triangles without area;
 //! - [`place`] scales, turns about x (Z-up and Y-up exports) and stands the mesh on the bed;
@@ -19,6 +20,8 @@
 
 use std::collections::HashMap;
 use std::io::Cursor;
+
+use foldhash::fast::FixedState;
 use std::path::{Path, PathBuf};
 
 use glam::{DVec2, DVec3};
@@ -136,6 +139,60 @@ pub fn parse_stl(bytes: &[u8]) -> Result<Mesh, MeshError> {
     })
 }
 
+/// Reads a Wavefront OBJ file's bytes ([`tobj`], faces triangulated) into one mesh; positions
+/// equal to the bit are shared across the file's objects and groups, as STL's are.
+pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| MeshError::Read(format!("not a Wavefront OBJ file: {e}")))?;
+    let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    if triangles > MAX_TRIANGLES {
+        return Err(MeshError::TooLarge(triangles as u64));
+    }
+    let mut mesh = Mesh::default();
+    let mut index: HashMap<[u32; 3], u32, FixedState> =
+        HashMap::with_capacity_and_hasher(triangles, FixedState::default());
+    for model in &models {
+        let m = &model.mesh;
+        let mut shared = Vec::with_capacity(m.positions.len() / 3);
+        for p in m.positions.chunks_exact(3) {
+            let key = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+            let next = mesh.vertices.len() as u32;
+            let i = *index.entry(key).or_insert_with(|| {
+                mesh.vertices
+                    .push(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+                next
+            });
+            shared.push(i);
+        }
+        for t in m.indices.chunks_exact(3) {
+            let corner = |k: usize| shared.get(t[k] as usize).copied();
+            match (corner(0), corner(1), corner(2)) {
+                (Some(a), Some(b), Some(c)) => mesh.triangles.push([a, b, c]),
+                _ => return Err(MeshError::Read("a face names a vertex the file does not have".into())),
+            }
+        }
+    }
+    if mesh.triangles.is_empty() {
+        return Err(MeshError::Empty);
+    }
+    if let Some(bad) = mesh.vertices.iter().find(|v| !v.is_finite()) {
+        return Err(MeshError::Read(format!("a vertex is not a number: {bad}")));
+    }
+    Ok(mesh)
+}
+
+/// Whether `path` names an OBJ mesh (else STL).
+fn is_obj(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+}
+
 /// Whether the first kilobyte looks like text (an ASCII STL), not a binary header that happens
 /// to begin with "solid" (several exporters write that).
 fn is_probably_text(bytes: &[u8]) -> bool {
@@ -149,6 +206,14 @@ fn is_probably_text(bytes: &[u8]) -> bool {
 fn twice_area(m: &Mesh, t: &[u32; 3]) -> f64 {
     let [a, b, c] = t.map(|i| m.vertices[i as usize]);
     (b - a).cross(c - a).length()
+}
+
+/// Maps keyed by edges: a fast deterministic hasher (SipHash took most of the closed-body check
+/// of a million triangles).
+type EdgeMap<V> = HashMap<u64, V, FixedState>;
+
+fn edge_map<V>(capacity: usize) -> EdgeMap<V> {
+    HashMap::with_capacity_and_hasher(capacity, FixedState::default())
 }
 
 /// An undirected edge between two vertices, as one number.
@@ -176,7 +241,7 @@ pub fn check_closed_body(mesh: &Mesh) -> Result<Mesh, MeshError> {
         return Err(MeshError::Degenerate { bad, total });
     }
     // Edge → the triangles on it.
-    let mut edges: HashMap<u64, (u32, u32, u8)> = HashMap::with_capacity(kept.len() * 3 / 2);
+    let mut edges: EdgeMap<(u32, u32, u8)> = edge_map(kept.len() * 3 / 2);
     for (ti, t) in kept.iter().enumerate() {
         for e in 0..3 {
             let key = edge_key(t[e], t[(e + 1) % 3]);
@@ -292,7 +357,7 @@ pub fn slice_outlines(mesh: &Mesh, heights: &[f64]) -> Result<Vec<Vec<DVec2>>, M
 fn outline_at(mesh: &Mesh, tris: &[u32], h: f64) -> Result<Vec<DVec2>, MeshError> {
     // Every straddling triangle crosses the plane on two edges: one segment between them.
     let mut segments: Vec<[u64; 2]> = Vec::with_capacity(tris.len());
-    let mut points: HashMap<u64, DVec2> = HashMap::with_capacity(tris.len());
+    let mut points: EdgeMap<DVec2> = edge_map(tris.len());
     for &ti in tris {
         let t = mesh.triangles[ti as usize];
         let mut ends = [0u64; 2];
@@ -318,7 +383,7 @@ fn outline_at(mesh: &Mesh, tris: &[u32], h: f64) -> Result<Vec<DVec2>, MeshError
         return Err(MeshError::EmptySlice { z: h });
     }
     // Chain the segments through the edges they share (each edge is on two of them).
-    let mut by_edge: HashMap<u64, [u32; 2]> = HashMap::with_capacity(segments.len());
+    let mut by_edge: EdgeMap<[u32; 2]> = edge_map(segments.len());
     for (si, s) in segments.iter().enumerate() {
         for &e in s {
             let slot = by_edge.entry(e).or_insert([u32::MAX; 2]);
@@ -451,7 +516,12 @@ pub fn load_placed(path: &Path, source: &MeshSource) -> Result<Mesh, FieldError>
     }
     let bytes =
         std::fs::read(path).map_err(|e| mesh_field_error(path, format!("cannot read: {e}")))?;
-    let mesh = parse_stl(&bytes).map_err(|e| mesh_field_error(path, e))?;
+    let parsed = if is_obj(path) {
+        parse_obj(&bytes)
+    } else {
+        parse_stl(&bytes)
+    };
+    let mesh = parsed.map_err(|e| mesh_field_error(path, e))?;
     let mesh = check_closed_body(&mesh).map_err(|e| mesh_field_error(path, e))?;
     Ok(place(&mesh, source.scale, source.rotate_x))
 }
@@ -459,7 +529,7 @@ pub fn load_placed(path: &Path, source: &MeshSource) -> Result<Mesh, FieldError>
 /// The placed mesh cut into layers of about `layer_height` ([`layer_heights`]).
 pub fn slices(mesh: &Mesh, layer_height: f64, path: &Path) -> Result<MeshSlices, FieldError> {
     let (_, top) = z_range(mesh);
-    if !(top > layer_height) {
+    if top.is_nan() || top <= layer_height {
         return Err(mesh_field_error(
             path,
             format!("{top:.3} mm tall: less than one layer ({layer_height} mm)"),
@@ -640,6 +710,26 @@ mod tests {
             parse_stl(b"solid empty\nendsolid empty\n"),
             Err(MeshError::Empty)
         ));
+    }
+
+    #[test]
+    fn an_obj_file_reads_the_same_mesh_as_its_stl() {
+        let m = cylinder(12, 10.0, 20.0);
+        let mut obj = String::from("# a cylinder\no cylinder\n");
+        for v in &m.vertices {
+            obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
+        }
+        // Quads where the wall has them (tobj triangulates), triangles for the caps; a second
+        // group repeats the positions it uses, as some exporters do.
+        for t in &m.triangles {
+            obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        let read = parse_obj(obj.as_bytes()).unwrap();
+        assert_eq!(read.triangles.len(), m.triangles.len());
+        assert_eq!(read.vertices.len(), m.vertices.len());
+        check_closed_body(&read).unwrap();
+        assert!(matches!(parse_obj(b"v 0 0 0\nf 1 2 3\n"), Err(MeshError::Read(_))));
+        assert!(matches!(parse_obj(b"# nothing\n"), Err(MeshError::Empty)));
     }
 
     #[test]

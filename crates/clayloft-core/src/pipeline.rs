@@ -181,6 +181,8 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
     let (lo, hi) = (lo - half, hi + half);
     let field = if design.shape.center.is_some() {
         "shape.center"
+    } else if design.shape.mesh.is_some() {
+        "shape.mesh.scale"
     } else {
         "shape"
     };
@@ -226,10 +228,17 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
         }
     }
     if top > p.max_z {
+        let (field, hint) = match design.shape.mesh {
+            Some(_) => (
+                "shape.mesh.scale",
+                " (scale the mesh down with shape.mesh.scale)",
+            ),
+            None => ("shape.height", ""),
+        };
         return Err(FieldError::new(
-            "shape.height",
+            field,
             format!(
-                "the rim reaches z = {top:.1} mm, above the build height printer.max_z = {} mm",
+                "the rim reaches z = {top:.1} mm, above the build height printer.max_z = {} mm{hint}",
                 p.max_z
             ),
         ));

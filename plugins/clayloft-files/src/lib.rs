@@ -184,6 +184,12 @@ pub fn open_design(path: &Path) -> Result<Design, String> {
 /// folder, its picture and drawing paths are rewritten to lead from there to the same files
 /// ([`Design::moved_to`]); returns the design as saved.
 pub fn save_design(design: &Design, path: &Path) -> Result<Design, String> {
+    if clayloft_core::load::is_mesh_file(path) {
+        return Err(format!(
+            "{}: is a mesh, not a design file: save the design as .toml (it keeps the mesh as its shape)",
+            path.display()
+        ));
+    }
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),

@@ -41,24 +41,52 @@ pub fn design_form(
     egui::CollapsingHeader::new("Shape")
         .default_open(true)
         .show(ui, |ui| shape(ui, d));
-    egui::CollapsingHeader::new("Lower contour (on the bed)")
-        .default_open(true)
-        .show(ui, |ui| {
-            explain(ui, "The closed curve the vessel stands on.");
-            contour(ui, "lower", &mut d.shape.lower);
-        });
-    egui::CollapsingHeader::new("Upper contour (the rim)")
-        .default_open(true)
-        .show(ui, |ui| {
-            explain(
-                ui,
-                "The closed curve at the top; the wall is lofted between the two.",
-            );
-            contour(ui, "upper", &mut d.shape.upper);
-        });
-    egui::CollapsingHeader::new("Control lines")
-        .default_open(false)
-        .show(ui, |ui| control(ui, d));
+    if let Some(mesh) = &mut d.shape.mesh {
+        egui::CollapsingHeader::new("Mesh")
+            .default_open(true)
+            .show(ui, |ui| {
+                explain(
+                    ui,
+                    "The vessel's shape comes from this mesh, sliced at every layer: the printed wall's outside lies on the mesh's surface.",
+                );
+                ui.label(format!("file: {}", mesh.path.display()));
+                number(
+                    ui,
+                    "Scale",
+                    &mut mesh.scale,
+                    "×",
+                    0.0001..=10_000.0,
+                    "Multiplies the mesh's numbers: 1 if they are millimetres, 10 for centimetres, 25.4 for inches.",
+                );
+                number(
+                    ui,
+                    "Turn about x",
+                    &mut mesh.rotate_x,
+                    "°",
+                    -360.0..=360.0,
+                    "Turns the mesh before slicing: 90 stands up a mesh exported with y up.",
+                );
+            });
+    } else {
+        egui::CollapsingHeader::new("Lower contour (on the bed)")
+            .default_open(true)
+            .show(ui, |ui| {
+                explain(ui, "The closed curve the vessel stands on.");
+                contour(ui, "lower", &mut d.shape.lower);
+            });
+        egui::CollapsingHeader::new("Upper contour (the rim)")
+            .default_open(true)
+            .show(ui, |ui| {
+                explain(
+                    ui,
+                    "The closed curve at the top; the wall is lofted between the two.",
+                );
+                contour(ui, "upper", &mut d.shape.upper);
+            });
+        egui::CollapsingHeader::new("Control lines")
+            .default_open(false)
+            .show(ui, |ui| control(ui, d));
+    }
     egui::CollapsingHeader::new("Texture")
         .default_open(false)
         .show(ui, |ui| texture(ui, &mut d.texture));
@@ -77,7 +105,10 @@ pub fn design_form(
 
 fn shape(ui: &mut egui::Ui, d: &mut Design) {
     let s = &mut d.shape;
-    field(ui, "shape.height", &mut s.height);
+    if s.mesh.is_none() {
+        // A mesh's height is the mesh's.
+        field(ui, "shape.height", &mut s.height);
+    }
     count(
         ui,
         "shape.samples",
@@ -693,6 +724,22 @@ mod tests {
                 },
                 design,
             )
+    }
+
+    #[test]
+    fn a_design_from_a_mesh_shows_the_mesh_not_contours() {
+        let mut d = design();
+        d.shape.mesh = Some(clayloft_core::design::MeshSource {
+            path: "vase.stl".into(),
+            scale: 1.0,
+            rotate_x: 0.0,
+        });
+        let mut h = form_of(d);
+        h.run();
+        assert!(h.query_by_label("file: vase.stl").is_some());
+        assert!(h.query_by_label("Scale").is_some());
+        assert!(h.query_by_label("Lower contour (on the bed)").is_none());
+        assert!(h.query_by_label("Control lines").is_none());
     }
 
     #[test]

@@ -82,7 +82,13 @@ fn draw_panels(
             .path
             .clone()
             .unwrap_or_else(|| PathBuf::from("untitled.toml"));
-        fields.design = base.display().to_string();
+        // A mesh opened on its own is saved as a design next to it, never over it.
+        let design_file = if clayloft_core::load::is_mesh_file(&base) {
+            base.with_extension("toml")
+        } else {
+            base.clone()
+        };
+        fields.design = design_file.display().to_string();
         fields.gcode = base.with_extension("gcode").display().to_string();
         fields.stl = base.with_extension("stl").display().to_string();
     }
