@@ -175,7 +175,11 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, MeshError> {
             let corner = |k: usize| shared.get(t[k] as usize).copied();
             match (corner(0), corner(1), corner(2)) {
                 (Some(a), Some(b), Some(c)) => mesh.triangles.push([a, b, c]),
-                _ => return Err(MeshError::Read("a face names a vertex the file does not have".into())),
+                _ => {
+                    return Err(MeshError::Read(
+                        "a face names a vertex the file does not have".into(),
+                    ));
+                }
             }
         }
     }
@@ -190,7 +194,8 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, MeshError> {
 
 /// Whether `path` names an OBJ mesh (else STL).
 fn is_obj(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
 }
 
 /// Whether the first kilobyte looks like text (an ASCII STL), not a binary header that happens
@@ -728,7 +733,10 @@ mod tests {
         assert_eq!(read.triangles.len(), m.triangles.len());
         assert_eq!(read.vertices.len(), m.vertices.len());
         check_closed_body(&read).unwrap();
-        assert!(matches!(parse_obj(b"v 0 0 0\nf 1 2 3\n"), Err(MeshError::Read(_))));
+        assert!(matches!(
+            parse_obj(b"v 0 0 0\nf 1 2 3\n"),
+            Err(MeshError::Read(_))
+        ));
         assert!(matches!(parse_obj(b"# nothing\n"), Err(MeshError::Empty)));
     }
 

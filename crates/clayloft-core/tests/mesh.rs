@@ -188,3 +188,30 @@ fn bad_meshes_are_design_errors_naming_the_file() {
     let e = parse_design("version = 1\n[shape]\nheight = 50.0\n").unwrap_err();
     assert!(format!("{e:?}").contains("shape.lower"), "{e:?}");
 }
+
+#[test]
+fn an_obj_mesh_prints_like_the_same_stl() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = solid_of_revolution(64, 31, 40.0, |z| 25.0 + 3.0 * (z / 40.0).sin());
+    let stl = dir.path().join("v.stl");
+    write_stl(&mesh, &stl);
+    let obj = dir.path().join("v.obj");
+    let mut text = String::from("o vase\n");
+    for v in &mesh.vertices {
+        text += &format!("v {} {} {}\n", v.x as f32, v.y as f32, v.z as f32);
+    }
+    for t in &mesh.triangles {
+        text += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(&obj, text).unwrap();
+    let (a, b) = (
+        clayloft_core::run(&mesh_design(&stl, "")).unwrap(),
+        clayloft_core::run(&mesh_design(&obj, "")).unwrap(),
+    );
+    assert_eq!(a.surface.layers, b.surface.layers);
+    for (sa, sb) in a.surface.sections.iter().zip(&b.surface.sections) {
+        for (p, q) in sa.points.iter().zip(&sb.points) {
+            assert!(p.distance(*q) < 1e-4, "{p} vs {q}");
+        }
+    }
+}
