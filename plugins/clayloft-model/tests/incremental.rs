@@ -349,3 +349,28 @@ fn handle_at(app: &mut App, role: HandleRole) -> bevy::math::DVec3 {
         .map(|(_, p)| p.0)
         .unwrap()
 }
+
+#[test]
+fn a_mesh_design_builds_its_vessel_without_handles_and_back() {
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/lobed-vase.stl");
+    let from_mesh = clayloft_core::load_design(&mesh).unwrap().design;
+    let mut app = app_with(from_mesh.clone());
+    assert_eq!(surface(&mut app).0.layers, 90);
+    assert_eq!(count::<EditHandle>(&mut app), 0, "a mesh has no handles");
+    assert!(app.world().resource::<ModelStatus>().errors.is_empty());
+    // A texture edit re-does the surface from the same slices.
+    let passes = app.world().resource::<RecomputeLog>().passes;
+    let texture = load("ellipse-ripple.toml").texture;
+    assert!(texture.is_some());
+    app.world_mut().resource_mut::<DesignDoc>().design.texture = texture;
+    app.update();
+    let log = app.world().resource::<RecomputeLog>().clone();
+    assert_eq!(log.passes, passes + 1);
+    assert!(log.update.surface && !log.update.plan && log.update.sections.is_empty(), "{log:?}");
+    // Back to a lofted design: contours, handles and sections return.
+    app.world_mut().resource_mut::<DesignDoc>().design = load("pebble-spout.toml");
+    app.update();
+    app.update();
+    assert!(count::<EditHandle>(&mut app) > 0);
+    assert_matches_pipeline(&mut app);
+}
