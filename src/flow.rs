@@ -329,14 +329,7 @@ fn groove(o: &FlowOptions, m: Material) -> Result<Setup, Failure> {
         l.dx * 1e6,
     );
     Ok(Setup {
-        solver: Solver::new(
-            l.nx,
-            l.ny,
-            l.fluid,
-            Boundaries::cavity(l.lid_u),
-            clayloft_flow::cavity::TAU_MIN,
-            clayloft_flow::cavity::TAU_MAX,
-        ),
+        solver: l.solver(),
         scale_lu: l.lid_u,
         cell_mm: Some(l.dx * 1e3),
         to_ms: l.lid_speed / l.lid_u,

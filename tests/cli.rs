@@ -714,41 +714,10 @@ fn flow_channel_shows_the_plug_of_a_yield_stress_slurry() {
 }
 
 /// A closed solid of revolution as binary STL bytes: `n` around, `rings` from 0 to `h`.
-fn revolution_stl(n: usize, rings: usize, h: f32, r: impl Fn(f32) -> f32) -> Vec<u8> {
-    let mut v = Vec::new();
-    for k in 0..rings {
-        let z = h * k as f32 / (rings - 1) as f32;
-        for i in 0..n {
-            let a = std::f32::consts::TAU * i as f32 / n as f32;
-            v.push([r(z) * a.cos(), r(z) * a.sin(), z]);
-        }
-    }
-    let (bottom, top) = (v.len(), v.len() + 1);
-    v.push([0.0, 0.0, 0.0]);
-    v.push([0.0, 0.0, h]);
-    let at = |k: usize, i: usize| k * n + i % n;
-    let mut t = Vec::new();
-    for k in 0..rings - 1 {
-        for i in 0..n {
-            t.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
-            t.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
-        }
-    }
-    for i in 0..n {
-        t.push([bottom, at(0, i + 1), at(0, i)]);
-        t.push([top, at(rings - 1, i), at(rings - 1, i + 1)]);
-    }
-    let mut bytes = vec![b' '; 80];
-    bytes.extend((t.len() as u32).to_le_bytes());
-    for tri in &t {
-        bytes.extend([0u8; 12]);
-        for &i in tri {
-            for c in v[i] {
-                bytes.extend(c.to_le_bytes());
-            }
-        }
-        bytes.extend([0u8; 2]);
-    }
+fn revolution_stl(n: usize, rings: usize, h: f64, r: impl Fn(f64) -> f64) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    let mesh = clayloft_core::mesh::revolution(n, rings, h, r);
+    clayloft_core::stl::write_binary_stl(&mesh, "vessel", &mut bytes).unwrap();
     bytes
 }
 
@@ -775,7 +744,7 @@ fn a_mesh_prints_directly_and_from_a_design_that_names_it() {
     std::fs::write(
         dir.path().join("tall.stl"),
         revolution_stl(64, 11, 8.0, |z| {
-            3.0 + 0.5 * (z / 8.0 * std::f32::consts::PI).sin()
+            3.0 + 0.5 * (z / 8.0 * std::f64::consts::PI).sin()
         }),
     )
     .unwrap();

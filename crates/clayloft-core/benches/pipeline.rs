@@ -121,36 +121,12 @@ fn gcode_writing(c: &mut Criterion) {
     g.finish();
 }
 
-/// A closed vessel of revolution with `n` points round and `rings` rings up to 300 mm: 2·n·rings
-/// triangles, about a million for n = 1000, rings = 500.
+/// A closed vessel of revolution 300 mm tall with `n` points round and `rings` rings: 2·n·rings
+/// triangles, about a million for n = 1000, rings = 501.
 fn revolution_mesh(n: usize, rings: usize) -> clayloft_core::stl::Mesh {
-    use glam::DVec3;
-    let h = 300.0;
-    let mut m = clayloft_core::stl::Mesh::default();
-    for k in 0..rings {
-        let z = h * k as f64 / (rings - 1) as f64;
-        let r = 60.0 + 15.0 * (std::f64::consts::PI * z / h).sin();
-        for i in 0..n {
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            m.vertices.push(DVec3::new(r * a.cos(), r * a.sin(), z));
-        }
-    }
-    let (bottom, top) = (m.vertices.len() as u32, m.vertices.len() as u32 + 1);
-    m.vertices.push(DVec3::ZERO);
-    m.vertices.push(DVec3::new(0.0, 0.0, h));
-    let at = |k: usize, i: usize| (k * n + i % n) as u32;
-    for k in 0..rings - 1 {
-        for i in 0..n {
-            m.triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
-            m.triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
-        }
-    }
-    for i in 0..n {
-        m.triangles.push([bottom, at(0, i + 1), at(0, i)]);
-        m.triangles
-            .push([top, at(rings - 1, i), at(rings - 1, i + 1)]);
-    }
-    m
+    clayloft_core::mesh::revolution(n, rings, 300.0, |z| {
+        60.0 + 15.0 * (std::f64::consts::PI * z / 300.0).sin()
+    })
 }
 
 /// Slicing a million-triangle vessel into 300 layers (issue 16), and checking it is one closed

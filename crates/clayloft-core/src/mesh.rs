@@ -489,6 +489,38 @@ pub fn wall_sections(
     sections
 }
 
+/// A closed solid of revolution — a thrown pot's shape: rings of `n` points at `rings` heights
+/// from 0 to `height`, radius `radius(z)`, closed by a fan at the bottom and at the top, faces
+/// outward. For tests, benchmarks and examples of meshes.
+pub fn revolution(n: usize, rings: usize, height: f64, radius: impl Fn(f64) -> f64) -> Mesh {
+    let (n, rings) = (n.max(3), rings.max(2));
+    let mut m = Mesh::default();
+    for k in 0..rings {
+        let z = height * k as f64 / (rings - 1) as f64;
+        let r = radius(z);
+        for i in 0..n {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            m.vertices.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+        }
+    }
+    let (bottom, top) = (m.vertices.len() as u32, m.vertices.len() as u32 + 1);
+    m.vertices.push(DVec3::ZERO);
+    m.vertices.push(DVec3::new(0.0, 0.0, height));
+    let at = |k: usize, i: usize| (k * n + i % n) as u32;
+    for k in 0..rings - 1 {
+        for i in 0..n {
+            m.triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
+            m.triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
+        }
+    }
+    for i in 0..n {
+        m.triangles.push([bottom, at(0, i + 1), at(0, i)]);
+        m.triangles
+            .push([top, at(rings - 1, i), at(rings - 1, i + 1)]);
+    }
+    m
+}
+
 /// A placed mesh cut at the layer heights: the outer outline at each, and the pitch.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshSlices {
@@ -577,25 +609,7 @@ mod tests {
 
     /// A closed cylinder of `n` sides, radius r, height h, centred on the origin.
     pub(crate) fn cylinder(n: usize, r: f64, h: f64) -> Mesh {
-        let mut m = Mesh::default();
-        for z in [0.0, h] {
-            for i in 0..n {
-                let a = std::f64::consts::TAU * i as f64 / n as f64;
-                m.vertices.push(DVec3::new(r * a.cos(), r * a.sin(), z));
-            }
-        }
-        m.vertices.push(DVec3::new(0.0, 0.0, 0.0));
-        m.vertices.push(DVec3::new(0.0, 0.0, h));
-        let (bc, tc) = (2 * n as u32, 2 * n as u32 + 1);
-        for i in 0..n as u32 {
-            let j = (i + 1) % n as u32;
-            let (b0, b1, t0, t1) = (i, j, i + n as u32, j + n as u32);
-            m.triangles.push([b0, b1, t1]);
-            m.triangles.push([b0, t1, t0]);
-            m.triangles.push([bc, b1, b0]);
-            m.triangles.push([tc, t0, t1]);
-        }
-        m
+        revolution(n, 2, h, |_| r)
     }
 
     #[test]

@@ -6,36 +6,10 @@ use std::path::Path;
 use clayloft_core::design::Design;
 use clayloft_core::load::parse_design;
 use clayloft_core::stl::{Mesh, wall_mesh, write_binary_stl};
-use glam::{DVec2, DVec3};
+use glam::DVec2;
 
-/// A closed solid of revolution: rings of `n` points at `rings` heights from 0 to `h`, radius
-/// `r(z)`, capped by a fan at the bottom and the top.
 fn solid_of_revolution(n: usize, rings: usize, h: f64, r: impl Fn(f64) -> f64) -> Mesh {
-    let mut m = Mesh::default();
-    for k in 0..rings {
-        let z = h * k as f64 / (rings - 1) as f64;
-        for i in 0..n {
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            m.vertices
-                .push(DVec3::new(r(z) * a.cos(), r(z) * a.sin(), z));
-        }
-    }
-    let (bottom, top) = (m.vertices.len() as u32, m.vertices.len() as u32 + 1);
-    m.vertices.push(DVec3::ZERO);
-    m.vertices.push(DVec3::new(0.0, 0.0, h));
-    let at = |k: usize, i: usize| (k * n + i % n) as u32;
-    for k in 0..rings - 1 {
-        for i in 0..n {
-            m.triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
-            m.triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
-        }
-    }
-    for i in 0..n {
-        m.triangles.push([bottom, at(0, i + 1), at(0, i)]);
-        m.triangles
-            .push([top, at(rings - 1, i), at(rings - 1, i + 1)]);
-    }
-    m
+    clayloft_core::mesh::revolution(n, rings, h, r)
 }
 
 fn write_stl(mesh: &Mesh, path: &Path) {

@@ -102,6 +102,19 @@ pub struct LatticeGroove {
 }
 
 impl LatticeGroove {
+    /// The solver of this groove: the slurry at rest, the barrel wall moving, the yield-stress
+    /// clamp of [`crate::cavity`].
+    pub fn solver(&self) -> crate::Solver {
+        crate::Solver::new(
+            self.nx,
+            self.ny,
+            self.fluid,
+            crate::Boundaries::cavity(self.lid_u),
+            crate::cavity::TAU_MIN,
+            crate::cavity::TAU_MAX,
+        )
+    }
+
     /// The yield stress in lattice units (0 without one): where a cell's shear stress
     /// ([`crate::Solver::shear_stresses`]) stays below it, the slurry does not yield.
     pub fn yield_stress(&self) -> f64 {

@@ -299,7 +299,7 @@ fn bingham_cavity_vortex_climbs_and_plug_grows_with_the_bingham_number() {
 #[test]
 fn a_slower_screw_leaves_more_of_the_slurry_unyielded() {
     use clayloft_flow::analysis::{dead_cells, unyielded_fraction};
-    use clayloft_flow::cavity::{TAU_MAX, TAU_MIN, diffusion_steps};
+    use clayloft_flow::cavity::diffusion_steps;
     use clayloft_flow::groove::{Groove, material};
     let cells = 48;
     let shares: Vec<(f64, f64, usize)> = [90.0, 45.0, 15.0, 5.0]
@@ -313,14 +313,7 @@ fn a_slower_screw_leaves_more_of_the_slurry_unyielded() {
                 material: material("ceramic-slurry").unwrap(),
             };
             let l = g.to_lattice(cells, 1.0);
-            let mut s = Solver::new(
-                l.nx,
-                l.ny,
-                l.fluid,
-                Boundaries::cavity(l.lid_u),
-                TAU_MIN,
-                TAU_MAX,
-            );
+            let mut s = l.solver();
             s.threads = 2;
             s.advance(diffusion_steps(cells, 1.0 / 6.0));
             let (_, change) = s.run_to_convergence(1000, 1e-6, 400_000, l.lid_u, |_, _| {});

@@ -13,9 +13,7 @@ use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use clayloft_flow::analysis::{
     dead_cells, speed_colour, streamlines, unyielded_fraction, vortex_centre,
 };
-use clayloft_flow::cavity::{TAU_MAX, TAU_MIN};
 use clayloft_flow::groove::{Groove, MATERIALS, Material};
-use clayloft_flow::{Boundaries, Solver};
 use clayloft_ui::{Corner, toggle_on_title_click, tool_window};
 
 /// The window's title.
@@ -159,14 +157,7 @@ fn start(s: FlowSettings) -> Run {
             material: s.slurry(),
         };
         let l = g.to_lattice(CELLS, 1.0);
-        let mut solver = Solver::new(
-            l.nx,
-            l.ny,
-            l.fluid,
-            Boundaries::cavity(l.lid_u),
-            TAU_MIN,
-            TAU_MAX,
-        );
+        let mut solver = l.solver();
         let mut prev: Option<Vec<f64>> = None;
         while !flag.load(Ordering::Relaxed) {
             solver.advance(500);

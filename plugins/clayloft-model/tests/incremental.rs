@@ -366,7 +366,10 @@ fn a_mesh_design_builds_its_vessel_without_handles_and_back() {
     app.update();
     let log = app.world().resource::<RecomputeLog>().clone();
     assert_eq!(log.passes, passes + 1);
-    assert!(log.update.surface && !log.update.plan && log.update.sections.is_empty(), "{log:?}");
+    assert!(
+        log.update.surface && !log.update.plan && log.update.sections.is_empty(),
+        "{log:?}"
+    );
     // Back to a lofted design: contours, handles and sections return.
     app.world_mut().resource_mut::<DesignDoc>().design = load("pebble-spout.toml");
     app.update();
