@@ -3,6 +3,7 @@
 //! and a status line. Panels edit the design document only; everything else follows from it.
 
 mod design_form;
+mod reference;
 mod source_preview;
 mod widgets;
 
@@ -44,7 +45,7 @@ impl Plugin for PanelsPlugin {
             )
             .add_systems(
                 EguiPrimaryContextPass,
-                draw_source_previews.in_set(clayloft_ui::UiSystems::Windows),
+                (draw_source_previews, draw_reference).in_set(clayloft_ui::UiSystems::Windows),
             );
     }
 }
@@ -260,6 +261,28 @@ fn draw_panels(
         editing: ctx.egui_is_using_pointer(),
         typing: ctx.egui_wants_keyboard_input(),
     });
+    Ok(())
+}
+
+/// The title of the window with the paper's tables.
+const REFERENCE_WINDOW: &str = "Reference: the paper's tables";
+
+/// The paper's reference tables, for teaching ([`reference`]).
+fn draw_reference(mut contexts: EguiContexts) -> Result {
+    let ctx = contexts.ctx_mut()?.clone();
+    clayloft_ui::tool_window(
+        &ctx,
+        REFERENCE_WINDOW,
+        clayloft_ui::Corner::BottomCentre,
+        false,
+    )
+    .default_width(620.0)
+    .show(&ctx, |ui| {
+        egui::ScrollArea::vertical()
+            .max_height(420.0)
+            .show(ui, reference::reference);
+    });
+    clayloft_ui::toggle_on_title_click(&ctx, REFERENCE_WINDOW, false);
     Ok(())
 }
 

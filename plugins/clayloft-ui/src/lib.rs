@@ -61,6 +61,8 @@ pub enum Corner {
     TopRight,
     BottomLeft,
     BottomRight,
+    /// The middle of the bottom edge.
+    BottomCentre,
 }
 
 impl Corner {
@@ -70,6 +72,7 @@ impl Corner {
             Corner::TopRight => egui::Align2::RIGHT_TOP,
             Corner::BottomLeft => egui::Align2::LEFT_BOTTOM,
             Corner::BottomRight => egui::Align2::RIGHT_BOTTOM,
+            Corner::BottomCentre => egui::Align2::CENTER_BOTTOM,
         }
     }
 
@@ -80,6 +83,7 @@ impl Corner {
             Corner::TopRight => area.right_top(),
             Corner::BottomLeft => area.left_bottom(),
             Corner::BottomRight => area.right_bottom(),
+            Corner::BottomCentre => area.center_bottom(),
         }
     }
 }
