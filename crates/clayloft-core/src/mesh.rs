@@ -769,3 +769,62 @@ mod tests {
         check_closed_body(&b).unwrap();
     }
 }
+
+#[cfg(test)]
+mod hostile {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A small valid mesh as binary and as ASCII STL.
+    fn files() -> (Vec<u8>, Vec<u8>) {
+        let m = revolution(8, 3, 20.0, |z| 10.0 + z / 4.0);
+        let (mut b, mut a) = (Vec::new(), Vec::new());
+        crate::stl::write_binary_stl(&m, "x", &mut b).unwrap();
+        crate::stl::write_ascii_stl(&m, "x", &mut a).unwrap();
+        (b, a)
+    }
+
+    /// Whatever the bytes, reading, checking, placing and slicing end in a mesh or an error.
+    fn survives(bytes: &[u8]) {
+        for parsed in [parse_stl(bytes), parse_obj(bytes)] {
+            let Ok(m) = parsed else { continue };
+            let Ok(m) = check_closed_body(&m) else {
+                continue;
+            };
+            let placed = place(&m, 1.0, 90.0);
+            let (_, top) = z_range(&placed);
+            if top.is_finite() && top > 1.0 && top < 1e4 {
+                let (heights, _) = layer_heights(top, 1.0);
+                let _ = slice_outlines(&placed, &heights);
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Bytes of a valid file changed at random places: never a panic.
+        #[test]
+        fn mutated_files_never_panic(
+            ascii in any::<bool>(),
+            edits in proptest::collection::vec((any::<u16>(), any::<u8>()), 1..12),
+            cut in any::<u16>(),
+        ) {
+            let (b, a) = files();
+            let mut bytes = if ascii { a } else { b };
+            for (at, v) in edits {
+                let i = at as usize % bytes.len();
+                bytes[i] = v;
+            }
+            let keep = bytes.len() - (cut as usize % 64).min(bytes.len());
+            bytes.truncate(keep);
+            survives(&bytes);
+        }
+
+        /// Random bytes: never a panic.
+        #[test]
+        fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..600)) {
+            survives(&bytes);
+        }
+    }
+}
