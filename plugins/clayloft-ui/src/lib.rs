@@ -97,21 +97,30 @@ pub fn tool_window<'a>(
     open: bool,
 ) -> egui::Window<'a> {
     let area = tool_area(ctx);
+    // The id egui derives from a title is not `Id::new(title)`: set it, so that
+    // [`toggle_on_title_click`] finds the window's parts.
     egui::Window::new(title)
+        .id(egui::Id::new(title))
         .default_open(open)
         .pivot(corner.align())
         .default_pos(corner.of(area))
         .constrain_to(area)
 }
 
-/// Opens or closes the window titled `title` when its title bar was clicked once (the collapse
-/// arrow and a double click already do). Call after showing it.
+/// Opens or closes the window titled `title` (made by [`tool_window`]) when its title bar was
+/// clicked once; egui itself wants a click on the small arrow or a double click (the arrow is not
+/// part of egui's title area, so it is not toggled twice). Call after showing the window.
 pub fn toggle_on_title_click(ctx: &egui::Context, title: &str, default_open: bool) {
     let id = egui::Id::new(title);
     let Some(title_bar) = ctx.read_response(id.with("__title_click")) else {
         return;
     };
-    if title_bar.clicked() && !title_bar.double_clicked() {
+    // egui may run a frame's input through more than one pass: toggle once per frame.
+    let frame = ctx.cumulative_frame_nr();
+    let last = id.with("clayloft title toggled");
+    let again = ctx.data(|d| d.get_temp::<u64>(last)) == Some(frame);
+    if title_bar.clicked() && !title_bar.double_clicked() && !again {
+        ctx.data_mut(|d| d.insert_temp(last, frame));
         let mut state = egui::collapsing_header::CollapsingState::load_with_default_open(
             ctx,
             id.with("collapsing"),
@@ -120,5 +129,52 @@ pub fn toggle_on_title_click(ctx: &egui::Context, title: &str, default_open: boo
         state.set_open(!state.is_open());
         state.store(ctx);
         ctx.request_repaint();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable;
+
+    #[test]
+    fn a_click_on_the_title_opens_and_closes_a_tool_window() {
+        let mut h = Harness::builder()
+            .with_size(egui::vec2(800.0, 600.0))
+            .build_ui(|ui| {
+                let ctx = &ui.ctx().clone();
+                set_tool_area(
+                    ctx,
+                    egui::Rect::from_min_max(egui::pos2(300.0, 40.0), egui::pos2(780.0, 560.0)),
+                );
+                tool_window(ctx, "Tools", Corner::TopRight, false).show(ctx, |ui| {
+                    ui.label("inside the window");
+                });
+                toggle_on_title_click(ctx, "Tools", false);
+            });
+        h.run();
+        assert!(
+            h.query_by_label("inside the window").is_none(),
+            "starts closed"
+        );
+        h.get_by_label("Tools").click();
+        h.run();
+        assert!(
+            h.query_by_label("inside the window").is_some(),
+            "one click opens it"
+        );
+        // It stays inside the view area, in its corner.
+        let rect = h.get_by_label("inside the window").rect();
+        assert!(
+            rect.max.x <= 780.0 && rect.min.x >= 300.0 && rect.min.y >= 40.0,
+            "{rect:?}"
+        );
+        h.get_by_label("Tools").click();
+        h.run();
+        assert!(
+            h.query_by_label("inside the window").is_none(),
+            "another click closes it"
+        );
     }
 }
