@@ -486,6 +486,31 @@ mod tests {
     }
 
     #[test]
+    fn a_mesh_design_saves_beside_its_mesh_never_over_it() {
+        let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/lobed-vase.stl");
+        let before = std::fs::read(&mesh).unwrap();
+        let d = open_design(&mesh).unwrap();
+        let e = save_design(&d, &mesh).unwrap_err();
+        assert!(e.contains("is a mesh"), "{e}");
+        assert_eq!(
+            std::fs::read(&mesh).unwrap(),
+            before,
+            "the mesh is untouched"
+        );
+        // Saved as a design in another folder: the mesh path leads to the same file.
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("vase.toml");
+        let saved = save_design(&d, &out).unwrap();
+        let back = open_design(&out).unwrap();
+        assert_eq!(back, saved);
+        let (a, b) = (
+            clayloft_core::run(&d).unwrap(),
+            clayloft_core::run(&back).unwrap(),
+        );
+        assert_eq!(a.toolpath.points, b.toolpath.points);
+    }
+
+    #[test]
     fn saving_over_an_annotated_design_keeps_its_comments() {
         let dir = tempfile::tempdir().unwrap();
         let pictures = dir.path().join("contours");
