@@ -644,6 +644,44 @@ fn flow_writes_fields_profiles_and_picture_and_finds_the_vortex() {
         dir.path().to_str().unwrap(),
     ]);
     assert_bad_input(&out, &["--rpm -3"]);
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "cavity",
+        "--bingham=-3",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_bad_input(&out, &["--bingham -3"]);
+}
+
+#[test]
+fn flow_bingham_cavity_reports_the_plug() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = clayloft(&[
+        "flow",
+        "--case",
+        "cavity",
+        "--bingham",
+        "20",
+        "--cells",
+        "32",
+        "--threads",
+        "2",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let s = text(&out.stdout);
+    assert!(s.contains("Bingham lid-driven cavity, Bn = 20"), "{s}");
+    assert!(s.contains("converged after"), "{s}");
+    let share: f64 = s
+        .lines()
+        .find_map(|l| l.strip_prefix("unyielded (shear stress below the yield stress): "))
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .expect("the unyielded share");
+    assert!((40.0..80.0).contains(&share), "{share} %");
 }
 
 #[test]
