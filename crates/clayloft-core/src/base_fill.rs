@@ -183,6 +183,17 @@ fn offset(foot: &Polyline<f64>, d: f64) -> Result<Vec<Vec<DVec2>>, FillError> {
         .collect())
 }
 
+/// The closed outline `outline` (counter-clockwise) moved inward by `d` exactly — each point `d`
+/// from the outline, corners rounded where the outline turns outward — as its largest ring
+/// (where the outline is narrower than 2·d somewhere the offset splits; the narrow part cannot
+/// hold the path anyway). `None` when nothing is left.
+pub fn inward_offset(outline: &[DVec2], d: f64) -> Option<Vec<DVec2>> {
+    offset(&polyline(outline), d)
+        .ok()?
+        .into_iter()
+        .max_by(|a, b| crate::geometry::signed_area(a).total_cmp(&crate::geometry::signed_area(b)))
+}
+
 /// A ring as the offsetting library has it (with arcs) and as the path draws it.
 type ExactRing = (Polyline<f64>, Vec<DVec2>);
 

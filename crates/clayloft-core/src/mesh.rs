@@ -27,9 +27,7 @@ use std::path::{Path, PathBuf};
 use glam::{DVec2, DVec3};
 
 use crate::design::MeshSource;
-use crate::geometry::{
-    contains_point, dedup_closed, outward_normals, resample_closed, signed_area,
-};
+use crate::geometry::{contains_point, dedup_closed, resample_closed, signed_area};
 use crate::sample::min_twist_offset;
 use crate::section::Section;
 use crate::stl::Mesh;
@@ -457,25 +455,37 @@ fn outline_at(mesh: &Mesh, tris: &[u32], h: f64) -> Result<Vec<DVec2>, MeshError
     Ok(outline)
 }
 
-/// The wall sections from the outlines at `heights`: `samples` points at equal arc length, inset
-/// by `inset` along the outward normal, each turned to the start that twists least against the
-/// one below; section 0 lies on the bed (z = 0).
+/// The wall sections from the outlines at `heights`: each outline moved inward by `inset`
+/// exactly ([`crate::base_fill::inward_offset`]: every point of the path `inset` from the
+/// surface, so the bead's outside never pokes out of the model at a corner), sampled at
+/// `samples` points of equal arc length, and turned to the start that twists least against the
+/// section below; section 0 lies on the bed (z = 0). An outline with nothing left inside the
+/// inset keeps its own points.
 pub fn wall_sections(
     outlines: &[Vec<DVec2>],
     heights: &[f64],
     samples: usize,
     inset: f64,
 ) -> Vec<Section> {
+    // The offsets, on both cores (a few hundred outlines of a thousand points); outlines far
+    // denser than the path are thinned first (the offset costs with their points).
+    let rings: Vec<Vec<DVec2>> = crate::parallel::map_ranges(outlines.len(), 16, |r| {
+        outlines[r]
+            .iter()
+            .map(|outline| {
+                let dense = if outline.len() > 8 * samples {
+                    resample_closed(outline, 8 * samples)
+                } else {
+                    outline.clone()
+                };
+                let inside = crate::base_fill::inward_offset(&dense, inset).unwrap_or(dense);
+                resample_closed(&inside, samples)
+            })
+            .collect()
+    });
     let mut sections: Vec<Section> = Vec::with_capacity(outlines.len());
     let mut below: Option<Vec<DVec2>> = None;
-    for (k, (outline, &h)) in outlines.iter().zip(heights).enumerate() {
-        let ring = resample_closed(outline, samples);
-        let normals = outward_normals(&ring);
-        let mut xy: Vec<DVec2> = ring
-            .iter()
-            .zip(&normals)
-            .map(|(p, n)| *p - *n * inset)
-            .collect();
+    for (k, (mut xy, &h)) in rings.into_iter().zip(heights).enumerate() {
         if let Some(prev) = &below {
             let o = min_twist_offset(prev, &xy);
             xy.rotate_left(o);

@@ -189,3 +189,47 @@ fn an_obj_mesh_prints_like_the_same_stl() {
         }
     }
 }
+
+#[test]
+fn at_a_sharp_corner_the_bead_stays_inside_the_model() {
+    // A box 60 × 60 × 30 mm: its corners are sharper than any bead can follow.
+    let mut m = Mesh::default();
+    for z in [0.0, 30.0] {
+        for (x, y) in [(-30.0, -30.0), (30.0, -30.0), (30.0, 30.0), (-30.0, 30.0)] {
+            m.vertices.push(glam::DVec3::new(x, y, z));
+        }
+    }
+    for i in 0..4u32 {
+        let j = (i + 1) % 4;
+        m.triangles.push([i, j, j + 4]);
+        m.triangles.push([i, j + 4, i + 4]);
+    }
+    m.triangles
+        .extend([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7]]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box.stl");
+    write_stl(&m, &path);
+    let design = mesh_design(&path, "");
+    let job = clayloft_core::run(&design).expect("the box prints");
+    let half = design.printer.line_width / 2.0;
+    let s = &job.surface;
+    let mut nearest = f64::INFINITY;
+    for section in s.sections.iter().skip(1) {
+        for p in &section.points {
+            let q = p.truncate() - s.center;
+            // Distance from the path to the box's side: the bead's outside is half a bead out.
+            let to_side = (30.0 - q.x.abs()).min(30.0 - q.y.abs());
+            nearest = nearest.min(to_side);
+            assert!(
+                to_side <= half + 0.01
+                    || (q.x.abs() > 30.0 - 2.0 * half && q.y.abs() > 30.0 - 2.0 * half),
+                "off the side away from a corner: {to_side} at {q}"
+            );
+        }
+    }
+    assert!(
+        nearest >= half - 0.01,
+        "the bead pokes {:.3} mm out of the model",
+        half - nearest
+    );
+}
