@@ -75,6 +75,10 @@ pub enum MeshError {
     SeveralOutlines { z: f64, outlines: usize },
     #[error("the slice at z = {z:.2} mm is empty: the mesh does not reach that height")]
     EmptySlice { z: f64 },
+    #[error(
+        "at z = {z:.2} mm the vessel is narrower than a bead ({width} mm): nothing of it is left half a bead inside its surface"
+    )]
+    NarrowerThanABead { z: f64, width: f64 },
     #[error("{0}")]
     Size(String),
 }
@@ -460,16 +464,16 @@ fn outline_at(mesh: &Mesh, tris: &[u32], h: f64) -> Result<Vec<DVec2>, MeshError
 /// surface, so the bead's outside never pokes out of the model at a corner), sampled at
 /// `samples` points of equal arc length, and turned to the start that twists least against the
 /// section below; section 0 lies on the bed (z = 0). An outline with nothing left inside the
-/// inset keeps its own points.
+/// inset (the vessel narrower than a bead there) is an error at its height.
 pub fn wall_sections(
     outlines: &[Vec<DVec2>],
     heights: &[f64],
     samples: usize,
     inset: f64,
-) -> Vec<Section> {
+) -> Result<Vec<Section>, MeshError> {
     // The offsets, on both cores (a few hundred outlines of a thousand points); outlines far
     // denser than the path are thinned first (the offset costs with their points).
-    let rings: Vec<Vec<DVec2>> = crate::parallel::map_ranges(outlines.len(), 16, |r| {
+    let rings: Vec<Option<Vec<DVec2>>> = crate::parallel::map_ranges(outlines.len(), 16, |r| {
         outlines[r]
             .iter()
             .map(|outline| {
@@ -478,14 +482,20 @@ pub fn wall_sections(
                 } else {
                     outline.clone()
                 };
-                let inside = crate::base_fill::inward_offset(&dense, inset).unwrap_or(dense);
-                resample_closed(&inside, samples)
+                let inside = crate::base_fill::inward_offset(&dense, inset)?;
+                Some(resample_closed(&inside, samples))
             })
             .collect()
     });
     let mut sections: Vec<Section> = Vec::with_capacity(outlines.len());
     let mut below: Option<Vec<DVec2>> = None;
-    for (k, (mut xy, &h)) in rings.into_iter().zip(heights).enumerate() {
+    for (k, (ring, &h)) in rings.into_iter().zip(heights).enumerate() {
+        let Some(mut xy) = ring else {
+            return Err(MeshError::NarrowerThanABead {
+                z: h,
+                width: 2.0 * inset,
+            });
+        };
         if let Some(prev) = &below {
             let o = min_twist_offset(prev, &xy);
             xy.rotate_left(o);
@@ -496,7 +506,7 @@ pub fn wall_sections(
         });
         below = Some(xy);
     }
-    sections
+    Ok(sections)
 }
 
 /// A closed solid of revolution — a thrown pot's shape: rings of `n` points at `rings` heights
@@ -548,7 +558,7 @@ pub fn resolve(source: &MeshSource, base: Option<&Path>) -> PathBuf {
 }
 
 /// A problem with the mesh file at `path`, as the design's error on `shape.mesh.path`.
-fn mesh_field_error(path: &Path, e: impl std::fmt::Display) -> FieldError {
+pub(crate) fn mesh_field_error(path: &Path, e: impl std::fmt::Display) -> FieldError {
     FieldError::new("shape.mesh.path", format!("{}: {e}", path.display()))
 }
 

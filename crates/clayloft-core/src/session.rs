@@ -514,6 +514,7 @@ impl Session {
                 design.shape.samples,
                 p.line_width / 2.0,
             )
+            .map_err(|e| crate::mesh::mesh_field_error(&path, e))?
             .into_iter()
             .map(|s| Section {
                 points: s.points.iter().map(|q| *q + center.extend(0.0)).collect(),

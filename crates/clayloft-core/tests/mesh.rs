@@ -142,6 +142,14 @@ fn bad_meshes_are_design_errors_naming_the_file() {
     write_stl(&solid_of_revolution(32, 3, 20.0, |_| 400.0), &path);
     let e = clayloft_core::run(&mesh_design(&path, "")).unwrap_err();
     assert!(e.to_string().contains("bed"), "{e}");
+    // A rod thinner than a bead: nothing is left half a bead inside it.
+    let path = dir.path().join("rod.stl");
+    write_stl(&solid_of_revolution(24, 3, 30.0, |_| 1.2), &path);
+    let e = clayloft_core::run(&mesh_design(&path, "")).unwrap_err();
+    assert!(
+        e.message.contains("rod.stl") && e.message.contains("narrower than a bead"),
+        "{e}"
+    );
     // Scaled to nothing; control lines, which do not apply to a mesh.
     let mut d = mesh_design(&path, "");
     d.shape.mesh.as_mut().unwrap().scale = 0.0;
