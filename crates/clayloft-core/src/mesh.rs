@@ -11,19 +11,18 @@
 //!   segment between two of its edges, and segments chain through the edges they share into
 //!   closed outlines. Outlines inside the outer one (a hollow vessel's inner wall) are left out;
 //!   a second outline beside it (a handle, a second vessel) cannot be one spiral and is refused;
-//! - [`wall_sections`] samples each outline at equal arc length, insets it by half a line width
-//!   (so that the printed bead's outside lies on the model's surface) and turns each section to
-//!   the start that twists least against the one below.
+//! - [`wall_sections`] moves each outline inward by half a line width exactly (so that the
+//!   printed bead's outside lies on the model's surface), samples it at equal arc length and
+//!   turns each section to the start that twists least against the one below.
 //!
 //! A vertex exactly on a slicing plane counts as above it, so every straddling triangle crosses
 //! the plane on exactly two edges and the chaining never meets a vertex.
 
 use std::collections::HashMap;
 use std::io::Cursor;
-
-use foldhash::fast::FixedState;
 use std::path::{Path, PathBuf};
 
+use foldhash::fast::FixedState;
 use glam::{DVec2, DVec3};
 
 use crate::design::MeshSource;
@@ -40,13 +39,17 @@ pub const MAX_TRIANGLES: usize = 20_000_000;
 pub const MAX_DEGENERATE_SHARE: f64 = 0.01;
 /// A triangle whose area is below this is degenerate, mm².
 const DEGENERATE_AREA: f64 = 1e-9;
+/// The fewest bytes an ASCII STL facet takes (`facet normal 0 0 0`, `outer loop`, three
+/// `vertex` lines, `endloop`, `endfacet`).
+const ASCII_FACET_BYTES: usize = 100;
 /// Outlines smaller than this beside the outer one are slicing noise, not a second body, mm².
 const NOISE_AREA: f64 = 1.0;
 
 /// What is wrong with a mesh, in words for the one-line message that names the file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
-    #[error("not an STL file: {0}")]
+    /// The file cannot be read as a mesh (the message says which format and why).
+    #[error("{0}")]
     Read(String),
     #[error(
         "truncated: the header announces {declared} triangles ({need} bytes), the file has {got} bytes"
@@ -79,8 +82,6 @@ pub enum MeshError {
         "at z = {z:.2} mm the vessel is narrower than a bead ({width} mm): nothing of it is left half a bead inside its surface"
     )]
     NarrowerThanABead { z: f64, width: f64 },
-    #[error("{0}")]
-    Size(String),
 }
 
 /// Reads an STL file's bytes (ASCII or binary) into a mesh with shared vertices.
@@ -89,7 +90,7 @@ pub fn parse_stl(bytes: &[u8]) -> Result<Mesh, MeshError> {
     if !ascii {
         if bytes.len() < 84 {
             return Err(MeshError::Read(format!(
-                "{} bytes, shorter than a binary STL header (84 bytes)",
+                "not an STL file: {} bytes, shorter than a binary STL header (84 bytes)",
                 bytes.len()
             )));
         }
@@ -105,15 +106,16 @@ pub fn parse_stl(bytes: &[u8]) -> Result<Mesh, MeshError> {
                 got: bytes.len() as u64,
             });
         }
-    } else if bytes.len() / 100 > MAX_TRIANGLES {
-        // An ASCII facet is at least ~150 bytes.
-        return Err(MeshError::TooLarge((bytes.len() / 150) as u64));
+    } else if bytes.len() / ASCII_FACET_BYTES > MAX_TRIANGLES {
+        return Err(MeshError::TooLarge(
+            (bytes.len() / ASCII_FACET_BYTES) as u64,
+        ));
     }
     let indexed = stl_io::read_stl(&mut Cursor::new(bytes)).map_err(|e| {
         if e.kind() == std::io::ErrorKind::UnexpectedEof {
-            MeshError::Read("it ends in the middle of a triangle".into())
+            MeshError::Read("not an STL file: it ends in the middle of a triangle".into())
         } else {
-            MeshError::Read(e.to_string())
+            MeshError::Read(format!("not an STL file: {e}"))
         }
     })?;
     if indexed.faces.is_empty() {
@@ -127,18 +129,23 @@ pub fn parse_stl(bytes: &[u8]) -> Result<Mesh, MeshError> {
         .iter()
         .map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
         .collect();
-    if let Some(bad) = vertices.iter().find(|v| !v.is_finite()) {
-        return Err(MeshError::Read(format!("a vertex is not a number: {bad}")));
-    }
     let triangles = indexed
         .faces
         .iter()
         .map(|f| f.vertices.map(|i| i as u32))
         .collect();
-    Ok(Mesh {
+    finite(Mesh {
         vertices,
         triangles,
     })
+}
+
+/// The mesh, unless a vertex is not a number (a text file can say `nan` or `1e999`).
+fn finite(mesh: Mesh) -> Result<Mesh, MeshError> {
+    match mesh.vertices.iter().find(|v| !v.is_finite()) {
+        Some(bad) => Err(MeshError::Read(format!("a vertex is not a number: {bad}"))),
+        None => Ok(mesh),
+    }
 }
 
 /// Reads a Wavefront OBJ file's bytes ([`tobj`], faces triangulated) into one mesh; positions
@@ -188,10 +195,7 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Mesh, MeshError> {
     if mesh.triangles.is_empty() {
         return Err(MeshError::Empty);
     }
-    if let Some(bad) = mesh.vertices.iter().find(|v| !v.is_finite()) {
-        return Err(MeshError::Read(format!("a vertex is not a number: {bad}")));
-    }
-    Ok(mesh)
+    finite(mesh)
 }
 
 /// Whether `path` names an OBJ mesh (else STL).
@@ -567,8 +571,9 @@ pub fn load_placed(path: &Path, source: &MeshSource) -> Result<Mesh, FieldError>
     let len = std::fs::metadata(path)
         .map_err(|e| mesh_field_error(path, format!("cannot read: {e}")))?
         .len();
-    // 84 bytes of header and 50 per triangle, or ~150 per ASCII facet.
-    if len > 84 + 200 * MAX_TRIANGLES as u64 {
+    // A binary file is 50 bytes a triangle, an ASCII one at least 100: twice that is the most
+    // a file of MAX_TRIANGLES can need (4 GB), read into memory.
+    if len > 84 + 2 * ASCII_FACET_BYTES as u64 * MAX_TRIANGLES as u64 {
         return Err(mesh_field_error(path, MeshError::TooLarge(len / 50)));
     }
     let bytes =

@@ -169,7 +169,7 @@ pub struct ToolpathKey {
 pub struct Update {
     /// The contours resampled, as their design fields (`shape.lower`, `shape.upper`).
     pub contours: Vec<&'static str>,
-    /// The loft and layer plan were rebuilt.
+    /// The loft and layer plan (for a design from a mesh: the mesh or its slices) were rebuilt.
     pub plan: bool,
     /// The sections reshaped, ascending.
     pub sections: Vec<usize>,

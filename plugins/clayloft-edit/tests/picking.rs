@@ -69,20 +69,26 @@ fn handle(app: &mut App, role: HandleRole) -> Entity {
         .unwrap_or_else(|| panic!("no handle {role:?}"))
 }
 
+/// Sends the mouse's pointer event `event` to `entity`, as Bevy's picking would, and runs a frame.
+fn send<E>(app: &mut App, entity: Entity, event: E)
+where
+    E: std::fmt::Debug + Clone + Reflect,
+    for<'a> Pointer<E>: Event<Trigger<'a>: Default>,
+{
+    app.world_mut()
+        .trigger(Pointer::new(PointerId::Mouse, location(), event, entity));
+    app.update();
+}
+
 fn click(app: &mut App, entity: Entity) {
     let hit = HitData::new(camera(app), 1.0, None, None);
-    app.world_mut().trigger(Pointer::new(
-        PointerId::Mouse,
-        location(),
-        Click {
-            button: PointerButton::Primary,
-            hit,
-            duration: Duration::from_millis(90),
-            count: 1,
-        },
-        entity,
-    ));
-    app.update();
+    let click = Click {
+        button: PointerButton::Primary,
+        hit,
+        duration: Duration::from_millis(90),
+        count: 1,
+    };
+    send(app, entity, click);
 }
 
 fn selected(app: &App) -> Option<HandleRole> {
@@ -150,16 +156,14 @@ fn a_drag_starting_on_a_stack_moves_the_handle_picked_there() {
     let picked = selected(&app).unwrap();
     assert_ne!(picked, rim);
     let hit = HitData::new(camera(&mut app), 1.0, None, None);
-    app.world_mut().trigger(Pointer::new(
-        PointerId::Mouse,
-        location(),
+    send(
+        &mut app,
+        entity,
         DragStart {
             button: PointerButton::Primary,
             hit,
         },
-        entity,
-    ));
-    app.update();
+    );
     let drag = app.world().resource::<clayloft_edit::ActiveDrag>().0;
     assert_eq!(
         drag.map(|d| d.role),
@@ -167,30 +171,26 @@ fn a_drag_starting_on_a_stack_moves_the_handle_picked_there() {
         "the picked handle is dragged"
     );
     // A press that moved a little is still a click: it picks from the stack as before.
-    app.world_mut().trigger(Pointer::new(
-        PointerId::Mouse,
-        location(),
+    send(
+        &mut app,
+        entity,
         Drag {
             button: PointerButton::Primary,
             distance: Vec2::new(2.0, 0.0),
             delta: Vec2::new(2.0, 0.0),
         },
-        entity,
-    ));
-    app.update();
+    );
     click(&mut app, entity);
     let after = selected(&app).unwrap();
     assert_ne!(after, picked, "the click moved on to the next handle");
-    app.world_mut().trigger(Pointer::new(
-        PointerId::Mouse,
-        location(),
+    send(
+        &mut app,
+        entity,
         DragEnd {
             button: PointerButton::Primary,
             distance: Vec2::new(2.0, 0.0),
         },
-        entity,
-    ));
-    app.update();
+    );
     assert!(
         app.world()
             .resource::<clayloft_edit::ActiveDrag>()
