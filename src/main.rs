@@ -14,7 +14,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use clayloft_core::check::{Limits, check_gcode};
 use clayloft_core::gcode::{format_duration, summarize, write_gcode};
-use clayloft_core::stl::{wall_mesh, write_ascii_stl, write_binary_stl};
+use clayloft_core::stl::{job_mesh, write_ascii_stl, write_binary_stl};
 use clayloft_core::{LoadedDesign, PrintJob, load_design};
 
 /// The design opened when none is given.
@@ -330,7 +330,7 @@ fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, F
 fn stl(design: &Path, out: &Path, ascii: bool, printer: Option<&str>) -> Result<ExitCode, Failure> {
     let (loaded, job) = job_of(design, printer)?;
     let d = &loaded.design;
-    let mesh = wall_mesh(&job.surface, d.printer.line_width, d.shape.base_layers);
+    let mesh = job_mesh(d, &job);
     clayloft_core::atomic::write_atomically(out, |w| {
         if ascii {
             write_ascii_stl(&mesh, &d.name, w)

@@ -312,6 +312,25 @@ fn absurd_sizes_are_bad_input_not_an_exhausted_machine() {
     );
 }
 
+/// Wall beads (SPEC §13): out of range, ties without a second bead, a vessel too narrow for them.
+#[test]
+fn bad_wall_beads_exit_2_naming_the_field() {
+    bad_design(
+        GOOD.replace("[shape]\n", "[shape]\nwalls = 4\n").as_bytes(),
+        &["shape.walls"],
+    );
+    bad_design(
+        GOOD.replace("[shape]\n", "[shape]\nwall_ties = true\n")
+            .as_bytes(),
+        &["shape.wall_ties"],
+    );
+    bad_design(
+        "version = 1\n[shape]\nheight = 20.0\nwalls = 3\n[shape.lower]\ntype = \"ellipse\"\nrx = 40.0\nry = 6.0\n[shape.upper]\ntype = \"ellipse\"\nrx = 40.0\nry = 6.0\n"
+            .as_bytes(),
+        &["shape.walls", "layer 0", "narrower than 3 beads"],
+    );
+}
+
 #[test]
 fn bad_design_files() {
     bad_design(

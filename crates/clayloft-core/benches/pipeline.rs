@@ -27,6 +27,19 @@ fn pipeline(c: &mut Criterion) {
             black_box(job.toolpath.points.len())
         })
     });
+    // The same vessel with a two-bead wall (issue 13): the inner bead offset per section, twice
+    // the path.
+    let two_beads = BIG_DESIGN.replace("[shape]\n", "[shape]\nwalls = 2\n");
+    assert!(parse_design(&two_beads).unwrap().shape.walls == 2);
+    g.bench_function("design_to_gcode_file_720x300_two_beads", |b| {
+        b.iter(|| {
+            let design = parse_design(&two_beads).unwrap();
+            let job = clayloft_core::run(&design).unwrap();
+            clayloft_core::atomic::write_atomically(&out, |w| write_gcode(&design, &job, w))
+                .unwrap();
+            black_box(job.toolpath.points.len())
+        })
+    });
     g.finish();
 }
 
@@ -97,6 +110,7 @@ fn gcode_writing(c: &mut Criterion) {
             metrics: Default::default(),
             point_leans_deg: Vec::new(),
         }),
+        beads: std::sync::Arc::new(Vec::new()),
         toolpath: std::sync::Arc::new(Toolpath {
             points,
             base_points: 0,

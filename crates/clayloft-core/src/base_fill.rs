@@ -188,10 +188,15 @@ fn offset(foot: &Polyline<f64>, d: f64) -> Result<Vec<Vec<DVec2>>, FillError> {
 /// (where the outline is narrower than 2·d somewhere the offset splits; the narrow part cannot
 /// hold the path anyway). `None` when nothing is left.
 pub fn inward_offset(outline: &[DVec2], d: f64) -> Option<Vec<DVec2>> {
-    offset(&polyline(outline), d)
-        .ok()?
+    inward_offset_rings(outline, d)?
         .into_iter()
         .max_by(|a, b| crate::geometry::signed_area(a).total_cmp(&crate::geometry::signed_area(b)))
+}
+
+/// Every ring of the closed outline's inward offset by `d` (more than one where the outline is
+/// narrower than 2·d somewhere), anticlockwise; `None` when the offset fails.
+pub fn inward_offset_rings(outline: &[DVec2], d: f64) -> Option<Vec<Vec<DVec2>>> {
+    offset(&polyline(outline), d).ok()
 }
 
 /// A ring as the offsetting library has it (with arcs) and as the path draws it.

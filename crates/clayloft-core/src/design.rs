@@ -357,6 +357,14 @@ pub struct Shape {
     pub center: Option<[f64; 2]>,
     #[serde(default = "default_base_layers")]
     pub base_layers: usize,
+    /// Beads side by side in the wall (SPEC §13), 1 ..= 3: the outer bead on the designed
+    /// surface, each further bead one line width inward, all in the one spiral.
+    #[serde(default = "default_walls", skip_serializing_if = "is_one_wall")]
+    pub walls: usize,
+    /// Weave the inner beads half a bead into the outer one and back (a zig-zag tie between the
+    /// beads), with `walls` ≥ 2.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub wall_ties: bool,
     /// Contour at z = 0 (not given for a design from a mesh).
     #[serde(
         default = "ContourSpec::missing",
@@ -401,6 +409,12 @@ fn default_samples() -> usize {
 }
 fn default_base_layers() -> usize {
     2
+}
+fn default_walls() -> usize {
+    1
+}
+fn is_one_wall(walls: &usize) -> bool {
+    *walls == 1
 }
 
 impl ContourSpec {

@@ -147,6 +147,40 @@ pub fn find_self_intersection(points: &[DVec2]) -> Option<(usize, usize)> {
     None
 }
 
+/// The closed polyline with the small loops it makes where it crosses itself cut off: for
+/// crossing segments `i < j` the shorter side between them (at most an eighth of the points) is
+/// replaced by the crossing point, until no crossing is left (each pass removes at least one
+/// point, so at most `n` passes). A crossing of two far-apart parts is left as it is.
+pub fn without_loops(points: &[DVec2]) -> Vec<DVec2> {
+    let mut p = points.to_vec();
+    while p.len() >= 4 {
+        let Some((i, j)) = find_self_intersection(&p) else {
+            break;
+        };
+        let n = p.len();
+        let (a0, a1, b0, b1) = (p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]);
+        let (da, db) = (a1 - a0, b1 - b0);
+        let denom = da.perp_dot(db);
+        let x = if denom.abs() > 1e-300 {
+            a0 + da * ((b0 - a0).perp_dot(db) / denom).clamp(0.0, 1.0)
+        } else {
+            a1 // collinear overlap: cut at the shared stretch's start
+        };
+        if (j - i).min(n - (j - i)) > n / 8 {
+            // Not a small loop: two parts of the outline cross; nothing to cut.
+            break;
+        }
+        if j - i <= n / 2 {
+            p.splice(i + 1..=j, [x]);
+        } else {
+            p = std::iter::once(x)
+                .chain(p[i + 1..=j].iter().copied())
+                .collect();
+        }
+    }
+    p
+}
+
 /// Outward unit normal in XY at each vertex of a counter-clockwise closed polyline, from the
 /// central difference `pᵢ₊₁ − pᵢ₋₁` rotated by −90°.
 pub fn outward_normals(points: &[DVec2]) -> Vec<DVec2> {
@@ -247,6 +281,36 @@ mod tests {
             })
             .collect();
         assert!(find_self_intersection(&eight).is_some());
+    }
+
+    #[test]
+    fn small_loops_are_cut_off_and_a_figure_eight_is_left_alone() {
+        // A circle of 100 points with a small kink that crosses back over itself (a loop of 4
+        // points near point 30).
+        let mut c = circle(10.0, 100);
+        let (a, b) = (c[30], c[33]);
+        c[31] = b + (b - a) * 0.3;
+        c[32] = a - (b - a) * 0.3;
+        assert!(find_self_intersection(&c).is_some());
+        let clean = without_loops(&c);
+        assert_eq!(find_self_intersection(&clean), None);
+        assert!(clean.len() >= 97 && clean.len() < 100, "{}", clean.len());
+        // Everywhere else the outline is unchanged.
+        assert!(
+            clean
+                .iter()
+                .all(|p| (p.length() - 10.0).abs() < 0.1 || p.length() < 10.0)
+        );
+        assert_eq!(clean[0], c[0]);
+        assert_eq!(clean[clean.len() - 1], c[99]);
+        // A figure eight's crossing joins halves: no loop to cut.
+        let eight: Vec<DVec2> = (0..400)
+            .map(|i| {
+                let t = TAU * i as f64 / 400.0;
+                DVec2::new(t.sin(), (2.0 * t).sin() * 0.5)
+            })
+            .collect();
+        assert_eq!(without_loops(&eight), eight);
     }
 
     #[test]

@@ -11,7 +11,8 @@
 //!    [`section`] on a layer plan that keeps layer heights printable;
 //! 4. [`constraint`] corrects the overhang locally and [`report`]s each correction;
 //! 5. [`texture`] embeds the periodic waves within the same limits;
-//! 6. [`toolpath`] joins the sections into one spiral, [`gcode`] writes it between the
+//! 6. [`toolpath`] joins the sections into one spiral (with a [`base_fill`] under it and, for a
+//!    wall of several beads, the [`walls`] inward of the surface), [`gcode`] writes it between the
 //!    dialect's [`templates`] with the host metadata and a [`thumbnail`], timed by [`motion`]
 //!    as firmware plans it; [`stl`] meshes the wall; [`check`] re-measures any G-code file
 //!    against the printer's limits.
@@ -53,6 +54,7 @@ pub mod thumbnail;
 pub mod toolpath;
 pub mod trace;
 pub mod validate;
+pub mod walls;
 
 pub use design::Design;
 pub use load::{DesignError, LoadedDesign, load_design};

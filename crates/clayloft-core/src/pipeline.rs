@@ -38,6 +38,8 @@ pub struct Surface {
 #[derive(Debug, Clone)]
 pub struct PrintJob {
     pub surface: Arc<Surface>,
+    /// The wall's inner beads ([`crate::walls::inner_beads`]): empty for a one-bead wall.
+    pub beads: Arc<Vec<Vec<Section>>>,
     pub toolpath: Arc<Toolpath>,
 }
 

@@ -149,12 +149,25 @@ pub struct BaseKey {
     pub wall: (usize, usize),
 }
 
+/// Inputs of the wall's inner beads: the surface (by revision), how many beads, their width and
+/// where their ties begin.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeadKey {
+    pub surface: u64,
+    pub walls: usize,
+    pub line_width: f64,
+    /// From which section the inner beads are tied (none: untied).
+    pub ties_from: Option<usize>,
+}
+
 /// Inputs of the spiral toolpath.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ToolpathKey {
     pub surface: u64,
     /// The base fill (by revision).
     pub base: u64,
+    /// The inner beads (by revision).
+    pub beads: u64,
     pub base_layers: usize,
     pub line_width: f64,
     pub min_layer_height: f64,
@@ -175,6 +188,8 @@ pub struct Update {
     pub sections: Vec<usize>,
     /// Overhang correction, texture, metrics and the fit on the machine were redone.
     pub surface: bool,
+    /// The wall's inner beads were rebuilt (SPEC §13; empty for a one-bead wall).
+    pub beads: bool,
     /// The spiral toolpath was rebuilt.
     pub toolpath: bool,
 }
@@ -194,6 +209,7 @@ struct LaterStages {
     texture: Stage<TextureKey, Vec<Vec<f64>>>,
     surface: Stage<SurfaceKey, Arc<Surface>>,
     base: Stage<BaseKey, Vec<crate::base_fill::BaseFill>>,
+    beads: Stage<BeadKey, Arc<Vec<Vec<Section>>>>,
     toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
 }
 
@@ -266,6 +282,7 @@ impl Session {
                 self.error = None;
                 self.job = Some(PrintJob {
                     surface: self.later.surface.get().expect("updated").clone(),
+                    beads: self.later.beads.get().expect("updated").clone(),
                     toolpath: self.later.toolpath.get().expect("updated").clone(),
                 });
                 if self.design.as_ref() != Some(design)
@@ -460,6 +477,11 @@ impl Session {
         self.later.surface.get()
     }
 
+    /// The wall's inner beads, `[j − 1][k]` bead `j`'s section `k` (empty for a one-bead wall).
+    pub fn beads(&self) -> Option<&Arc<Vec<Vec<Section>>>> {
+        self.later.beads.get()
+    }
+
     /// The spiral toolpath.
     pub fn toolpath(&self) -> Option<&Arc<Toolpath>> {
         self.later.toolpath.get()
@@ -602,9 +624,19 @@ fn finish_stages(
     later
         .base
         .refresh(key, || crate::toolpath::base_fills(design, &surface))?;
+    let key = BeadKey {
+        surface: later.surface.revision,
+        walls: design.shape.walls,
+        line_width: p.line_width,
+        ties_from: crate::toolpath::ties_from(design, &surface),
+    };
+    done.beads = later.beads.refresh(key, || {
+        crate::toolpath::inner_beads(design, &surface).map(Arc::new)
+    })?;
     let key = ToolpathKey {
         surface: later.surface.revision,
         base: later.base.revision,
+        beads: later.beads.revision,
         base_layers: design.shape.base_layers,
         line_width: p.line_width,
         min_layer_height: p.min_layer_height,
@@ -614,8 +646,9 @@ fn finish_stages(
         flow_ramp: (p.flow_ramp_start, p.flow_ramp_end),
     };
     let fills = later.base.get().expect("the base stage ran above");
+    let beads = later.beads.get().expect("the bead stage ran above");
     done.toolpath = later.toolpath.refresh(key, || {
-        build_toolpath_on(design, &surface, fills).map(Arc::new)
+        build_toolpath_on(design, &surface, fills, beads).map(Arc::new)
     })?;
     Ok(())
 }
@@ -670,7 +703,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
     /// The edits a user makes, one per case; some make the design invalid or unprintable.
     fn edit(d: &mut Design, which: u8, amount: f64) {
         let a = amount; // in [0, 1)
-        match which % 22 {
+        match which % 24 {
             0 => {
                 d.shape.lower = ContourSpec::Circle {
                     radius: 20.0 + 10.0 * a,
@@ -729,6 +762,8 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
             18 => d.printer.line_width = if a < 0.5 { -1.0 } else { 3.5 },
             19 => d.shape.center = Some([80.0 + 20.0 * a, 95.0]),
             20 => d.printer.nozzle_length = 5.0 + 30.0 * a,
+            21 => d.shape.walls = 1 + (a * 3.0) as usize,
+            22 => d.shape.wall_ties = a < 0.5 && d.shape.walls > 1,
             _ => d.printer.max_layer_height = 1.2 + a,
         }
     }
@@ -762,7 +797,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         /// exactly (bit for bit) the job a fresh run computes, and both fail alike.
         #[test]
         fn incremental_updates_equal_a_batch_run(
-            edits in proptest::collection::vec((0u8..22, 0.0f64..1.0), 1..12)
+            edits in proptest::collection::vec((0u8..24, 0.0f64..1.0), 1..12)
         ) {
             let mut d = design();
             let mut session = Session::new();
@@ -812,6 +847,21 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
                 ..Update::default()
             }
         );
+        // Two beads: the beads and the toolpath, not the surface.
+        e.shape.walls = 2;
+        let u = s.update(&e).unwrap();
+        assert_eq!(
+            u,
+            Update {
+                beads: true,
+                toolpath: true,
+                ..Update::default()
+            }
+        );
+        assert_eq!(s.beads().unwrap().len(), 1);
+        e.shape.walls = 1;
+        s.update(&e).unwrap();
+        assert!(s.beads().unwrap().is_empty());
         // The G-code-only settings: nothing at all.
         e.printer.flow_multiplier = 1.1;
         e.printer.thumbnail = false;

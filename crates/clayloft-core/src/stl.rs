@@ -1,12 +1,15 @@
-//! STL export (SPEC §7): the printed wall as a closed 2-manifold mesh — the section surface offset
-//! by ± line_width / 2 along the XY normal, closed by the rim on top and by the base (a solid
-//! disk `base_layers` thick) or, with an open bottom, by an annulus on the bed.
+//! STL export (SPEC §7): the printed wall as a closed 2-manifold mesh — the outer bead's surface
+//! offset outward by line_width / 2 along the XY normal, the innermost bead's (the same surface
+//! for a one-bead wall, SPEC §13) inward by as much, closed by the rim on top and by the base (a
+//! solid disk `base_layers` thick) or, with an open bottom, by an annulus on the bed.
 
 use std::io::{self, Write};
 
 use glam::{DVec3, Vec3};
 
-use crate::pipeline::Surface;
+use crate::design::Design;
+use crate::pipeline::{PrintJob, Surface};
+use crate::section::Section;
 
 /// A triangle mesh: vertices and counter-clockwise (outward-facing) triangles.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -15,17 +18,49 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// Builds the closed mesh of the printed wall.
-pub fn wall_mesh(surface: &Surface, line_width: f64, base_layers: usize) -> Mesh {
+impl Mesh {
+    /// Enclosed volume, mm³, by the divergence theorem: Σ a·(b × c)/6 over the triangles (positive
+    /// for a closed mesh with outward-facing triangles).
+    pub fn volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.vertices[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+}
+
+/// The closed mesh of a job's printed wall, all its beads.
+pub fn job_mesh(design: &Design, job: &PrintJob) -> Mesh {
+    let innermost = job.beads.last().map(Vec::as_slice);
+    wall_mesh(
+        &job.surface,
+        innermost,
+        design.printer.line_width,
+        design.shape.base_layers,
+    )
+}
+
+/// Builds the closed mesh of the printed wall: the outside from `surface`, the inside from the
+/// `innermost` bead's sections (the surface itself when `None`).
+pub fn wall_mesh(
+    surface: &Surface,
+    innermost: Option<&[Section]>,
+    line_width: f64,
+    base_layers: usize,
+) -> Mesh {
     let half = line_width / 2.0;
     let sections = &surface.sections;
+    let inside = innermost.unwrap_or(sections);
     let layers = sections.len() - 1;
     let n = sections[0].points.len();
     let base = base_layers.min(layers.saturating_sub(1));
     let mut m = Mesh::default();
     let ring = |m: &mut Mesh, k: usize, sign: f64| -> u32 {
         let start = m.vertices.len() as u32;
-        let s = &sections[k];
+        let s = if sign > 0.0 { &sections[k] } else { &inside[k] };
         for (p, nrm) in s.points.iter().zip(s.normals()) {
             let z = if k == 0 { 0.0 } else { p.z };
             m.vertices.push(DVec3::new(
@@ -186,17 +221,6 @@ pub(crate) mod tests {
         }
     }
 
-    /// Signed volume by the divergence theorem; positive for outward-facing triangles.
-    fn volume(m: &Mesh) -> f64 {
-        m.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| m.vertices[i as usize]);
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum()
-    }
-
     fn surface(base: usize) -> (crate::design::Design, Surface) {
         let d = crate::load::parse_design(&format!(
             "version = 1\n[shape]\nheight = 10.0\nsamples = 400\nbase_layers = {base}\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n"
@@ -209,35 +233,50 @@ pub(crate) mod tests {
     #[test]
     fn open_cylinder_wall_is_closed_with_the_tube_volume() {
         let (_, s) = surface(0);
-        let m = wall_mesh(&s, 3.0, 0);
+        let m = wall_mesh(&s, None, 3.0, 0);
         assert_closed_manifold(&m);
         // Tube of radii 28.5 and 31.5, 10 mm tall: π(31.5² − 28.5²)·10.
         let expected = std::f64::consts::PI * (31.5f64.powi(2) - 28.5f64.powi(2)) * 10.0;
         assert!(
-            (volume(&m) - expected).abs() / expected < 1e-3,
+            (m.volume() - expected).abs() / expected < 1e-3,
             "{}",
-            volume(&m)
+            m.volume()
         );
     }
 
     #[test]
     fn cup_with_base_is_closed_with_the_cup_volume() {
         let (_, s) = surface(2);
-        let m = wall_mesh(&s, 3.0, 2);
+        let m = wall_mesh(&s, None, 3.0, 2);
         assert_closed_manifold(&m);
         let expected = std::f64::consts::PI * (31.5f64.powi(2) - 28.5f64.powi(2)) * 8.0
             + std::f64::consts::PI * 31.5f64.powi(2) * 2.0;
         assert!(
-            (volume(&m) - expected).abs() / expected < 2e-3,
+            (m.volume() - expected).abs() / expected < 2e-3,
             "{}",
-            volume(&m)
+            m.volume()
+        );
+    }
+
+    #[test]
+    fn a_two_bead_wall_is_meshed_two_beads_thick() {
+        let (_, s) = surface(0);
+        let beads = crate::walls::inner_beads(&s, 2, 3.0, None).unwrap();
+        let m = wall_mesh(&s, beads.last().map(Vec::as_slice), 3.0, 0);
+        assert_closed_manifold(&m);
+        // Tube of radii 31.5 and 30 − 3 − 1.5 = 25.5.
+        let expected = std::f64::consts::PI * (31.5f64.powi(2) - 25.5f64.powi(2)) * 10.0;
+        assert!(
+            (m.volume() - expected).abs() / expected < 1e-3,
+            "{}",
+            m.volume()
         );
     }
 
     #[test]
     fn binary_stl_has_the_declared_size() {
         let (_, s) = surface(1);
-        let m = wall_mesh(&s, 3.0, 1);
+        let m = wall_mesh(&s, None, 3.0, 1);
         let mut v = Vec::new();
         write_binary_stl(&m, "cup", &mut v).unwrap();
         assert_eq!(v.len(), 84 + 50 * m.triangles.len());

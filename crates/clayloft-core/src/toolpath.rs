@@ -94,7 +94,32 @@ impl PathBuilder {
 /// Builds the single continuous spiral path of a surface.
 pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, FieldError> {
     let fills = base_fills(design, surface)?;
-    build_toolpath_on(design, surface, &fills)
+    let beads = inner_beads(design, surface)?;
+    build_toolpath_on(design, surface, &fills, &beads)
+}
+
+/// The inner beads of the design's wall ([`crate::walls::inner_beads`]); empty for one bead.
+pub fn inner_beads(design: &Design, surface: &Surface) -> Result<Vec<Vec<Section>>, FieldError> {
+    let s = &design.shape;
+    if wall_points(surface, s.walls) > MAX_PATH_POINTS as u128 {
+        // Too long a path: [`build_toolpath_on`] says so before anything is offset.
+        return Ok(Vec::new());
+    }
+    crate::walls::inner_beads(
+        surface,
+        s.walls,
+        design.printer.line_width,
+        ties_from(design, surface),
+    )
+}
+
+/// The first section whose inner beads are tied (`wall_ties`): the wall's first revolution, on
+/// the base or the bed, runs untied so that it lies on what is below.
+pub fn ties_from(design: &Design, surface: &Surface) -> Option<usize> {
+    design
+        .shape
+        .wall_ties
+        .then(|| base_feet(design, surface).len().max(1) + 2)
 }
 
 /// The sections the base layers fill (1 ..= base, in XY): what [`base_fills`] reads.
@@ -106,10 +131,10 @@ pub fn base_feet(design: &Design, surface: &Surface) -> Vec<Vec<DVec2>> {
     (1..=base).map(|k| surface.sections[k].xy()).collect()
 }
 
-/// Points the wall of a surface makes at most.
-fn wall_points(surface: &Surface) -> u128 {
+/// Points the wall of a surface makes at most, with `walls` beads.
+fn wall_points(surface: &Surface, walls: usize) -> u128 {
     let n = surface.sections[0].points.len();
-    (surface.layers as u128 + 2) * (n as u128 + 1)
+    (surface.layers as u128 + 2) * (n as u128 + 1) * walls.max(1) as u128
 }
 
 /// The base layers' fills (`base_fill`), each from and to its section's point 0, bounded
@@ -121,7 +146,7 @@ pub fn base_fills(
     let p = &design.printer;
     let feet = base_feet(design, surface);
     let (base, n) = (feet.len(), surface.sections[0].points.len());
-    let wall_points = wall_points(surface);
+    let wall_points = wall_points(surface, design.shape.walls);
     if wall_points > MAX_PATH_POINTS as u128 {
         // The wall alone is too long: [`build_toolpath_on`] says so.
         return Ok(Vec::new());
@@ -161,13 +186,22 @@ pub fn base_fills(
     })
 }
 
-/// [`build_toolpath`] with the base fills already made ([`base_fills`] of this surface).
+/// [`build_toolpath`] with the base fills and inner beads already made ([`base_fills`] and
+/// [`inner_beads`] of this surface).
+///
+/// With `W` beads (SPEC §13) each revolution — one layer — is `W` turns: turn `t` follows bead
+/// `t` (outer first) and rises `1/W` of the layer, from `z_k + (t/W)·Δ` to `z_k + ((t+1)/W)·Δ`
+/// (Δ = z_{k+1} − z_k), then steps straight across to the next bead at point 0 (from the
+/// innermost back out to the outer bead). Each bead is thus laid on the same bead one revolution
+/// below, a full layer thick everywhere but at its seam, where it starts `(1 − 1/W)·Δ` above the
+/// end of its last turn (the validator keeps that printable). The levelled rim levels every bead.
 // Index loops: sample i addresses several parallel arrays (sections, fractions, z below).
 #[allow(clippy::needless_range_loop)]
 pub fn build_toolpath_on(
     design: &Design,
     surface: &Surface,
     fills: &[crate::base_fill::BaseFill],
+    inner: &[Vec<Section>],
 ) -> Result<Toolpath, FieldError> {
     let p = &design.printer;
     let sections = &surface.sections;
@@ -177,7 +211,11 @@ pub fn build_toolpath_on(
     let base = fills.len();
     let n = sections[0].points.len();
     let mut layer_starts = Vec::with_capacity(layers + base + 2);
-    let wall_points = wall_points(surface);
+    let beads: Vec<&[Section]> = std::iter::once(sections.as_slice())
+        .chain(inner.iter().map(Vec::as_slice))
+        .collect();
+    let walls = beads.len();
+    let wall_points = wall_points(surface, walls);
     let too_many = |points: u128| {
         FieldError::new(
             "shape.base_layers",
@@ -228,78 +266,99 @@ pub fn build_toolpath_on(
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
     }
     let base_points = b.points.len();
-    // 2. Flat first revolution (only without a base: the base's last layer ends with it).
+    // 2. Flat first layer (only without a base: the base's last layer ends with it), one turn
+    //    per bead.
     let first = base.max(1);
     let flat_z = first as f64 * h;
-    let mut z_below: Vec<f64> = vec![flat_z; n];
+    // The z each bead reached at each sample one revolution ago (index 0: where its turn ended).
+    let mut z_below: Vec<Vec<f64>> = vec![vec![flat_z; n]; walls];
+    // A one-bead wall continues from where it is; more beads step across at point 0.
+    let from = if walls > 1 { 0 } else { 1 };
     if base == 0 {
-        let ring = &sections[first];
         let start = b.points.len();
         layer_starts.push(start);
-        for i in 0..=n {
-            let q = ring.points[i % n];
-            b.push(DVec3::new(q.x, q.y, flat_z), flat_z);
+        for (t, bead) in beads.iter().enumerate() {
+            let ring = &bead[first];
+            for i in if t == 0 { 0 } else { from }..=n {
+                let q = ring.points[i % n];
+                b.push(DVec3::new(q.x, q.y, flat_z), flat_z);
+            }
         }
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
     }
     let wall_start = b.points.len();
     let mut revolutions = 1;
 
-    // 3. The helix: revolution k goes from section k to k+1.
+    // 3. The helix: revolution k goes from section k to k+1, turn t of it along bead t.
+    let share = 1.0 / walls as f64;
     for k in first..layers {
-        let (lo, hi) = (&sections[k], &sections[k + 1]);
-        let frac = arc_fractions(lo);
         let start = b.points.len();
         layer_starts.push(start);
-        let mut z_now = vec![0.0; n];
-        for i in 1..=n {
-            let f = frac[i];
-            let j = i % n;
-            let (z, g) = if k == first {
-                // Leave the flat revolution by at least the minimum layer height; XY follows the
-                // z progress so the lean never exceeds that of the sections.
-                let z0 = flat_z + a;
-                let z = z0 + (hi.points[j].z - z0) * f;
-                let rise = hi.points[j].z - flat_z;
-                (
-                    z,
-                    if rise > 0.0 {
-                        ((z - flat_z) / rise).clamp(0.0, 1.0)
-                    } else {
-                        f
-                    },
-                )
-            } else {
-                (lo.points[j].z + (hi.points[j].z - lo.points[j].z) * f, f)
-            };
-            let xy = lo.points[j].truncate().lerp(hi.points[j].truncate(), g);
-            // Consecutive revolutions measure arc length along slightly different sections, so
-            // the thickness can stray from the layer pitch by a few micrometres: keep it inside
-            // the printer's range exactly.
-            let z = z.clamp(z_below[j] + a, z_below[j] + p.max_layer_height.max(a));
-            let thickness = z - z_below[j];
-            b.push(DVec3::new(xy.x, xy.y, z), thickness);
-            z_now[j] = z;
+        for (t, bead) in beads.iter().enumerate() {
+            let (lo, hi) = (&bead[k], &bead[k + 1]);
+            let frac = arc_fractions(lo);
+            let below = &mut z_below[t];
+            let mut z_now = vec![0.0; n];
+            z_now[0] = below[0];
+            for i in from..=n {
+                let f = (t as f64 + frac[i]) * share;
+                let j = i % n;
+                let (z, g) = if k == first {
+                    // Leave the flat layer by at least the minimum layer height; XY follows the z
+                    // progress so the lean never exceeds that of the sections.
+                    let z0 = flat_z + a;
+                    let z = z0 + (hi.points[j].z - z0) * f;
+                    let rise = hi.points[j].z - flat_z;
+                    (
+                        z,
+                        if rise > 0.0 {
+                            ((z - flat_z) / rise).clamp(0.0, 1.0)
+                        } else {
+                            f
+                        },
+                    )
+                } else {
+                    (lo.points[j].z + (hi.points[j].z - lo.points[j].z) * f, f)
+                };
+                let xy = lo.points[j].truncate().lerp(hi.points[j].truncate(), g);
+                // Consecutive revolutions measure arc length along slightly different sections,
+                // so the thickness can stray from the layer pitch by a few micrometres: keep it
+                // inside the printer's range exactly. Point 0 (the step onto this bead) lies on
+                // where the bead's last turn ended.
+                let z = z.clamp(below[j] + a, below[j] + p.max_layer_height.max(a));
+                let thickness = z - below[j];
+                b.push(DVec3::new(xy.x, xy.y, z), thickness);
+                if i > 0 {
+                    z_now[j] = z;
+                }
+            }
+            *below = z_now;
         }
-        z_below = z_now;
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
         revolutions += 1;
     }
 
-    // 4. Levelled rim: a flat partial revolution at the top section's height while the layer
-    //    under it is at least min_layer_height thinner.
-    let top = &sections[layers];
+    // 4. Levelled rim: a flat turn at the top section's height on each bead, while the layer
+    //    under it is at least min_layer_height thinner (the innermost bead's turn stops where it
+    //    is not, as a one-bead rim does, and at the latest one sample before its seam).
     let start = b.points.len();
-    for i in 1..n {
-        let q = top.points[i];
-        let thickness = q.z - z_below[i];
-        // Only while the step onto the rim is a printable layer: with horizontal control lines
-        // the top section is not level, and where it climbs faster than the last revolution
-        // the rim would be a layer thicker than the printer lays (or a bead in the air).
-        if thickness < a || thickness > p.max_layer_height {
-            break;
+    'rim: for (t, bead) in beads.iter().enumerate() {
+        let top = &bead[layers];
+        let last = t + 1 == walls;
+        let (i0, i1) = (from, if last { n - 1 } else { n });
+        for i in i0..=i1 {
+            let j = i % n;
+            let q = top.points[j];
+            let thickness = q.z - z_below[t][j];
+            // Only while the step onto the rim is a printable layer: with horizontal control
+            // lines the top section is not level, and where it climbs faster than the last
+            // revolution the rim would be a layer thicker than the printer lays (or a bead in
+            // the air).
+            if thickness < a || thickness > p.max_layer_height {
+                break 'rim;
+            }
+            b.push(q, thickness);
         }
-        b.push(q, thickness);
     }
     if b.points.len() > start {
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
@@ -513,6 +572,69 @@ mod tests {
             assert!(
                 cov.uncovered < 0.02 && cov.doubled < 0.05,
                 "{name}: {cov:?}"
+            );
+        }
+    }
+
+    /// `walls` beads on a 30 mm cylinder: one path, turn t of every revolution on the circle of
+    /// radius 30 − 3t, each bead a full layer thick ((1 − 1/W) of one at its seam), no travel,
+    /// and the checker's verdict clean.
+    #[test]
+    fn a_wall_of_two_or_three_beads_is_one_path_with_every_bead_a_layer_thick() {
+        for walls in [2usize, 3] {
+            let d = parse_design(&format!(
+                "version = 1\n[shape]\nheight = 20.0\nsamples = 90\nbase_layers = 0\nwalls = {walls}\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n"
+            ))
+            .unwrap();
+            let job = run(&d).unwrap();
+            let pts = &job.toolpath.points;
+            let c = job.surface.center;
+            let w = d.printer.line_width;
+            // Flat first layer (W turns) and 19 revolutions of W turns, plus the rim.
+            assert_eq!(job.toolpath.layer_starts.len(), 21);
+            let radius_of = |q: &PathPoint| q.pos.truncate().distance(c);
+            let step = std::f64::consts::TAU * 30.0 / 90.0;
+            // No segment longer than a sample spacing or the step from the innermost bead back
+            // out to the outer one ((W − 1)·w, across the middle bead).
+            let longest = step.max((walls - 1) as f64 * w) * 1.001;
+            for s in pts.windows(2) {
+                let seg = s[0].pos.truncate().distance(s[1].pos.truncate());
+                assert!(seg < longest, "{walls} beads: segment {seg}");
+            }
+            // Every point on one of the bead circles, and each of them used.
+            let mut used = vec![0usize; walls];
+            for q in pts {
+                let t = ((30.0 - radius_of(q)) / w).round() as usize;
+                assert!(t < walls && (radius_of(q) - (30.0 - w * t as f64)).abs() < 0.01);
+                used[t] += 1;
+            }
+            assert!(used.iter().all(|&u| u > 19 * 90), "{used:?}");
+            // Thickness: a layer everywhere in the helix (past the first revolution and its seams,
+            // rim), (1 − 1/W) of one at each bead's seam.
+            let seam = 1.0 - 1.0 / walls as f64;
+            let starts = &job.toolpath.layer_starts;
+            let wall = &pts[starts[3]..starts[starts.len() - 1]];
+            for q in wall {
+                assert!(
+                    (q.thickness - 1.0).abs() < 1e-6 || (q.thickness - seam).abs() < 1e-6,
+                    "thickness {}",
+                    q.thickness
+                );
+            }
+            let seams = wall
+                .iter()
+                .filter(|q| (q.thickness - seam).abs() < 1e-6)
+                .count();
+            assert!(seams <= walls * 20, "{seams} seam points");
+            // The checker, knowing nothing of beads, finds a clean path.
+            let positions: Vec<DVec3> = pts.iter().map(|q| q.pos).collect();
+            let report =
+                crate::check::check_path(&positions, &crate::check::Limits::from(&d.printer));
+            assert!(report.ok(), "{walls} beads: {:?}", report.violations);
+            assert!(
+                report.max_layer_height <= 1.0 + 1e-3,
+                "{}",
+                report.max_layer_height
             );
         }
     }

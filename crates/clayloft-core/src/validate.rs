@@ -65,6 +65,40 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64, why: &str) -> Check {
     Ok(())
 }
 
+/// The wall's beads (SPEC §13): 1 ..= [`crate::walls::MAX_WALLS`]; ties need a second bead; and
+/// where a bead steps to the next once per turn, the seam's layer (the pitch less the rise of one
+/// turn, `layer_height · (1 − 1/walls)`) must still be one the printer can lay.
+fn walls(s: &crate::design::Shape, p: &Printer) -> Check {
+    let max = crate::walls::MAX_WALLS;
+    if s.walls < 1 || s.walls > max {
+        return Err(FieldError::new(
+            "shape.walls",
+            format!("{} is outside 1 ..= {max} beads side by side", s.walls),
+        ));
+    }
+    if s.wall_ties && s.walls < 2 {
+        return Err(FieldError::new(
+            "shape.wall_ties",
+            "ties join the beads of a wall of two or three beads: set walls = 2 or 3",
+        ));
+    }
+    if s.walls > 1 {
+        let seam = p.layer_height * (1.0 - 1.0 / s.walls as f64);
+        if seam < p.min_layer_height {
+            return Err(FieldError::new(
+                "shape.walls",
+                format!(
+                    "with {} beads each turn rises {:.3} mm, so where a bead starts its layer is {seam:.3} mm, less than printer.min_layer_height = {} mm (a taller layer_height or fewer beads)",
+                    s.walls,
+                    p.layer_height / s.walls as f64,
+                    p.min_layer_height
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The mesh a design takes its shape from: a path, a positive scale, a turn in degrees.
 fn mesh_source(m: &crate::design::MeshSource) -> Check {
     if m.path.as_os_str().is_empty() {
@@ -283,6 +317,7 @@ pub fn validate(d: &Design) -> Check {
             ),
         ));
     }
+    walls(s, p)?;
     if s.mesh.is_none() {
         for (field, c) in [("shape.lower", &s.lower), ("shape.upper", &s.upper)] {
             if c.is_missing() {

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use clayloft_core::design::Design;
 use clayloft_core::load::parse_design;
-use clayloft_core::stl::{Mesh, wall_mesh, write_binary_stl};
+use clayloft_core::stl::{Mesh, job_mesh, write_binary_stl};
 use glam::DVec2;
 
 fn solid_of_revolution(n: usize, rings: usize, h: f64, r: impl Fn(f64) -> f64) -> Mesh {
@@ -82,14 +82,7 @@ fn the_mesh_clayloft_writes_slices_back_to_the_same_wall() {
     let job = clayloft_core::run(&lofted).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bowl.stl");
-    write_stl(
-        &wall_mesh(
-            &job.surface,
-            lofted.printer.line_width,
-            lofted.shape.base_layers,
-        ),
-        &path,
-    );
+    write_stl(&job_mesh(&lofted, &job), &path);
     let mut from_mesh = lofted.clone();
     from_mesh.shape.mesh = Some(clayloft_core::design::MeshSource {
         path: path.clone(),

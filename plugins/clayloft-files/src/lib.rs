@@ -231,11 +231,7 @@ pub fn export_gcode(design: &Design, job: &PrintJob, path: &Path) -> Result<Stri
 
 /// Writes the printed wall of a job as a binary STL, as `clayloft stl` does.
 pub fn export_stl(design: &Design, job: &PrintJob, path: &Path) -> Result<String, String> {
-    let mesh = clayloft_core::stl::wall_mesh(
-        &job.surface,
-        design.printer.line_width,
-        design.shape.base_layers,
-    );
+    let mesh = clayloft_core::stl::job_mesh(design, job);
     write_atomically(path, |w| {
         clayloft_core::stl::write_binary_stl(&mesh, &design.name, w)
     })

@@ -53,7 +53,7 @@ fn rebuild_mesh(app: &mut App) {
         .unwrap()
         .0
         .clone();
-    std::hint::black_box(wall_buffers(&surface, 45.0).into_mesh());
+    std::hint::black_box(wall_buffers(&surface, None, 45.0).into_mesh());
     let path = world
         .query::<&ToolpathPath>()
         .single(world)

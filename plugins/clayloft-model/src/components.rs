@@ -60,6 +60,18 @@ pub struct Vessel;
 #[derive(Component, Debug, Clone)]
 pub struct VesselSurface(pub Arc<Surface>);
 
+/// The wall's inner beads (SPEC §13), on the vessel entity: `[j − 1][k]` is bead `j`'s section
+/// `k`; empty for a one-bead wall.
+#[derive(Component, Debug, Clone, Default)]
+pub struct VesselBeads(pub Arc<Vec<Vec<Section>>>);
+
+impl VesselBeads {
+    /// The innermost bead's sections, if the wall has more than one bead.
+    pub fn innermost(&self) -> Option<&[Section]> {
+        self.0.last().map(Vec::as_slice)
+    }
+}
+
 /// The single spiral toolpath.
 #[derive(Component, Debug, Clone)]
 pub struct ToolpathPath(pub Arc<Toolpath>);

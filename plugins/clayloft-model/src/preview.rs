@@ -5,6 +5,7 @@ use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 use clayloft_core::pipeline::Surface;
+use clayloft_core::section::Section;
 
 use crate::coords::to_world;
 
@@ -17,6 +18,8 @@ pub struct WallBuffers {
     pub indices: Vec<u32>,
     /// Points whose lean exceeds the limit.
     pub violating: usize,
+    /// Indices of one row of quads (between sections k and k + 1), all sheets.
+    pub indices_per_row: usize,
 }
 
 /// Colour of a wall point leaning `lean` degrees when the limit is `limit` degrees: clay when
@@ -41,14 +44,22 @@ pub fn lean_color(lean: f32, limit: f32) -> [f32; 4] {
 }
 
 /// Builds the wall buffers: one vertex per surface point, two triangles per quad between
-/// consecutive sections (closed around), normals from central differences.
-pub fn wall_buffers(surface: &Surface, limit_deg: f64) -> WallBuffers {
+/// consecutive sections (closed around), normals from central differences. With an `innermost`
+/// bead (a wall of several beads, SPEC §13) its sheet follows, facing inward and coloured by the
+/// outer bead's lean, so the wall shows its thickness; each row's triangles of both sheets are
+/// consecutive ([`WallBuffers::indices_per_row`]) so that a replay can show the rows printed.
+pub fn wall_buffers(
+    surface: &Surface,
+    innermost: Option<&[Section]>,
+    limit_deg: f64,
+) -> WallBuffers {
     let sections = &surface.sections;
     let rows = sections.len();
     let n = sections.first().map_or(0, |s| s.points.len());
     if rows < 2 || n < 3 {
         return WallBuffers::default();
     }
+    let innermost = innermost.filter(|b| b.len() == rows && b.iter().all(|s| s.points.len() == n));
     // The surface's own leans (measured once by the core); a surface put together by hand may
     // lack them.
     let computed;
@@ -58,39 +69,74 @@ pub fn wall_buffers(surface: &Surface, limit_deg: f64) -> WallBuffers {
         computed = clayloft_core::constraint::point_leans_deg(sections);
         &computed
     };
-    let positions: Vec<[f32; 3]> = sections
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| to_world(*p).to_array()))
+    let limit = limit_deg as f32;
+    let sheets: Vec<&[Section]> = std::iter::once(sections.as_slice())
+        .chain(innermost)
         .collect();
-    let at = |k: usize, i: usize| Vec3::from_array(positions[k * n + i]);
-    let mut normals = Vec::with_capacity(positions.len());
-    for k in 0..rows {
-        let (kd, ku) = (k.saturating_sub(1), (k + 1).min(rows - 1));
-        for i in 0..n {
-            let around = at(k, (i + 1) % n) - at(k, (i + n - 1) % n);
-            let up = at(ku, i) - at(kd, i);
-            // Contours run counter-clockwise seen from above: around × up points outward.
-            normals.push(around.cross(up).normalize_or_zero().to_array());
+    let mut b = WallBuffers {
+        indices_per_row: sheets.len() * n * 6,
+        violating: leans.iter().filter(|a| **a > limit + 0.5).count(),
+        ..WallBuffers::default()
+    };
+    for (sheet, rings) in sheets.iter().enumerate() {
+        let outward = if sheet == 0 { 1.0 } else { -1.0 };
+        let first = b.positions.len();
+        b.positions.extend(
+            rings
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| to_world(*p).to_array())),
+        );
+        let at = |k: usize, i: usize| Vec3::from_array(b.positions[first + k * n + i]);
+        let mut normals = Vec::with_capacity(rows * n);
+        for k in 0..rows {
+            let (kd, ku) = (k.saturating_sub(1), (k + 1).min(rows - 1));
+            for i in 0..n {
+                let around = at(k, (i + 1) % n) - at(k, (i + n - 1) % n);
+                let up = at(ku, i) - at(kd, i);
+                // Contours run counter-clockwise seen from above: around × up points outward.
+                normals.push((outward * around.cross(up).normalize_or_zero()).to_array());
+            }
+        }
+        b.normals.extend(normals);
+        b.colors.extend(leans.iter().map(|a| lean_color(*a, limit)));
+    }
+    b.indices.reserve((rows - 1) * b.indices_per_row);
+    for k in 0..rows - 1 {
+        for sheet in 0..sheets.len() {
+            let base = sheet * rows * n;
+            let (r0, r1) = ((base + k * n) as u32, (base + (k + 1) * n) as u32);
+            for i in 0..n as u32 {
+                let j = (i + 1) % n as u32;
+                if sheet == 0 {
+                    b.indices
+                        .extend_from_slice(&[r0 + i, r0 + j, r1 + j, r0 + i, r1 + j, r1 + i]);
+                } else {
+                    b.indices
+                        .extend_from_slice(&[r0 + i, r1 + j, r0 + j, r0 + i, r1 + i, r1 + j]);
+                }
+            }
         }
     }
-    let limit = limit_deg as f32;
-    let colors: Vec<[f32; 4]> = leans.iter().map(|a| lean_color(*a, limit)).collect();
-    let violating = leans.iter().filter(|a| **a > limit + 0.5).count();
-    let mut indices = Vec::with_capacity((rows - 1) * n * 6);
-    for k in 0..rows - 1 {
-        let (r0, r1) = ((k * n) as u32, ((k + 1) * n) as u32);
+    if sheets.len() > 1 {
+        // The rim between the sheets, facing up (last, so a replay shows it with the top row).
+        let top = rows - 1;
+        let first = b.positions.len() as u32;
+        for sheet in 0..2 {
+            for i in 0..n {
+                let v = sheet * rows * n + top * n + i;
+                b.positions.push(b.positions[v]);
+                b.normals.push(Vec3::Y.to_array());
+                b.colors.push(b.colors[v]);
+            }
+        }
+        let (o, inner) = (first, first + n as u32);
         for i in 0..n as u32 {
             let j = (i + 1) % n as u32;
-            indices.extend_from_slice(&[r0 + i, r0 + j, r1 + j, r0 + i, r1 + j, r1 + i]);
+            b.indices
+                .extend_from_slice(&[o + i, inner + j, inner + i, o + i, o + j, inner + j]);
         }
     }
-    WallBuffers {
-        positions,
-        normals,
-        colors,
-        indices,
-        violating,
-    }
+    b
 }
 
 impl WallBuffers {
@@ -144,7 +190,7 @@ mod tests {
         )
         .unwrap();
         let s = clayloft_core::pipeline::build_surface(&d).unwrap();
-        let b = wall_buffers(&s, 45.0);
+        let b = wall_buffers(&s, None, 45.0);
         assert_eq!(b.positions.len(), 36 * 11);
         assert_eq!(b.indices.len(), 36 * 10 * 6);
         assert_eq!(b.violating, 0);
@@ -152,6 +198,42 @@ mod tests {
         for (p, nrm) in b.positions.iter().zip(&b.normals) {
             let radial = (Vec3::from_array(*p) - c).with_y(0.0).normalize();
             assert!(radial.dot(Vec3::from_array(*nrm)) > 0.999, "{p:?} {nrm:?}");
+        }
+    }
+
+    #[test]
+    fn a_two_bead_wall_shows_an_inner_sheet_facing_inward_a_bead_inside() {
+        let d = clayloft_core::load::parse_design(
+            "version = 1\n[shape]\nheight = 10.0\nsamples = 36\nbase_layers = 0\nwalls = 2\n\
+             lower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
+        )
+        .unwrap();
+        let job = clayloft_core::run(&d).unwrap();
+        let b = wall_buffers(&job.surface, job.beads.last().map(Vec::as_slice), 45.0);
+        // Two sheets and the rim between them.
+        assert_eq!(b.positions.len(), 2 * 36 * 11 + 2 * 36);
+        assert_eq!(b.indices_per_row, 2 * 36 * 6);
+        assert_eq!(b.indices.len(), 10 * b.indices_per_row + 36 * 6);
+        let c = crate::coords::to_world(job.surface.center.extend(0.0));
+        for (p, nrm) in b.positions[36 * 11..2 * 36 * 11]
+            .iter()
+            .zip(&b.normals[36 * 11..])
+        {
+            let off = (Vec3::from_array(*p) - c).with_y(0.0);
+            // The sampled circle's offset: within the chord's sagitta of 17 mm.
+            assert!((off.length() - 17.0).abs() < 0.1, "{p:?}");
+            assert!(
+                off.normalize().dot(Vec3::from_array(*nrm)) < -0.999,
+                "{nrm:?}"
+            );
+        }
+        // Every triangle winds counter-clockwise (Bevy's front face) round its vertices' normal:
+        // the outside faces out, the inside in, the rim up.
+        let v = |i: u32| Vec3::from_array(b.positions[i as usize]);
+        for t in b.indices.chunks(3) {
+            let face = (v(t[1]) - v(t[0])).cross(v(t[2]) - v(t[0]));
+            let nrm = Vec3::from_array(b.normals[t[0] as usize]);
+            assert!(face.dot(nrm) > 0.0, "{t:?}");
         }
     }
 }

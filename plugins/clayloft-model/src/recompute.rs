@@ -142,6 +142,13 @@ pub fn recompute_model(
             .entity(*vessel)
             .insert(VesselSurface(Arc::clone(surface)));
     }
+    if update.beads
+        && let Some(beads) = session.beads()
+    {
+        commands
+            .entity(*vessel)
+            .insert(VesselBeads(Arc::clone(beads)));
+    }
     if update.toolpath
         && let Some(path) = session.toolpath()
     {

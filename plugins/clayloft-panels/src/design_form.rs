@@ -125,6 +125,18 @@ fn shape(ui: &mut egui::Ui, d: &mut Design) {
         0..=20,
         "Solid spiral layers that close the bottom (0 = open cylinder).",
     );
+    count(
+        ui,
+        "shape.walls",
+        "Wall beads",
+        &mut s.walls,
+        1..=clayloft_core::walls::MAX_WALLS,
+        "Beads side by side in the wall, inward of the designed outside: 2 or 3 make a thicker, stronger wall, still one continuous spiral.",
+    );
+    if s.walls > 1 {
+        ui.checkbox(&mut s.wall_ties, "tie the beads")
+            .on_hover_text("The inner beads zig-zag half a bead outward and back, pressing into the bead outside them every few centimetres.");
+    }
     let mut custom = s.center.is_some();
     if ui
         .checkbox(&mut custom, "Place off-centre")

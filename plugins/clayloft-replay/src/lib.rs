@@ -230,7 +230,7 @@ const HOLDER_HEIGHT: f32 = 35.0;
 
 fn prepare_replay_path(
     path: Query<&ToolpathPath, Changed<ToolpathPath>>,
-    vessel: Query<&VesselSurface>,
+    vessel: Query<(&VesselSurface, Option<&VesselBeads>)>,
     doc: Option<Res<DesignDoc>>,
     mut replay_path: ResMut<ReplayPath>,
     mut source: ResMut<PrintedSource>,
@@ -241,9 +241,13 @@ fn prepare_replay_path(
     };
     *replay_path = ReplayPath::new(&path.0, &doc.design.printer);
     replay.time_s = replay.time_s.min(replay_path.timeline.total_s());
-    if let Some(surface) = vessel.iter().next() {
+    if let Some((surface, beads)) = vessel.iter().next() {
         *source = PrintedSource {
-            buffers: wall_buffers(&surface.0, doc.design.printer.max_overhang_deg),
+            buffers: wall_buffers(
+                &surface.0,
+                beads.and_then(VesselBeads::innermost),
+                doc.design.printer.max_overhang_deg,
+            ),
             samples: surface.0.sections.first().map_or(0, |s| s.points.len()),
             rows_shown: usize::MAX,
         };
@@ -359,7 +363,7 @@ fn grow_printed_part(
         return;
     }
     source.rows_shown = rows;
-    let quads = rows.saturating_sub(1) * source.samples * 6;
+    let quads = rows.saturating_sub(1) * source.buffers.indices_per_row;
     let mut b = source.buffers.clone();
     b.indices.truncate(quads);
     let _ = meshes.insert(part.0.id(), b.into_mesh());

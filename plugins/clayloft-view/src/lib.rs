@@ -273,19 +273,31 @@ fn frame_camera_on_first_surface(
     *done = true;
 }
 
+/// The vessel's wall, when its surface or its beads changed.
+type ChangedWall<'w, 's> = Query<
+    'w,
+    's,
+    (&'static VesselSurface, Option<&'static VesselBeads>),
+    Or<(Changed<VesselSurface>, Changed<VesselBeads>)>,
+>;
+
 fn rebuild_wall_mesh(
-    vessel: Query<&VesselSurface, Changed<VesselSurface>>,
+    vessel: ChangedWall,
     doc: Option<Res<DesignDoc>>,
     wall: Single<&Mesh3d, With<WallView>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut stats: ResMut<WallStats>,
     mut rebuilds: ResMut<ViewRebuilds>,
 ) {
-    let (Some(surface), Some(doc)) = (vessel.iter().next(), doc) else {
+    let (Some((surface, beads)), Some(doc)) = (vessel.iter().next(), doc) else {
         return;
     };
     rebuilds.wall_mesh += 1;
-    let buffers = wall_buffers(&surface.0, doc.design.printer.max_overhang_deg);
+    let buffers = wall_buffers(
+        &surface.0,
+        beads.and_then(VesselBeads::innermost),
+        doc.design.printer.max_overhang_deg,
+    );
     stats.violating_points = buffers.violating;
     let _ = meshes.insert(wall.0.id(), buffers.into_mesh());
 }

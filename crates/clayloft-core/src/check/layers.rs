@@ -220,7 +220,7 @@ pub(super) fn measure_layers(
         if !measurable {
             continue;
         }
-        let (height, offset) = match below[j] {
+        let (height, angle) = match below[j] {
             Below::Skipped => continue,
             Below::Unmeasurable => {
                 measurable = false;
@@ -235,7 +235,7 @@ pub(super) fn measure_layers(
                 });
                 continue;
             }
-            Below::Layer { height, offset } => (height, offset),
+            Below::Layer { height, lean_deg } => (height, lean_deg),
         };
         report.min_layer_height = report.min_layer_height.min(height);
         report.max_layer_height = report.max_layer_height.max(height);
@@ -245,7 +245,6 @@ pub(super) fn measure_layers(
         if height > limits.max_layer_height + layer_tol {
             thick.add(height - limits.max_layer_height, lines[j]);
         }
-        let angle = offset.atan2(height.max(1e-9)).to_degrees();
         report.max_overhang_deg = report.max_overhang_deg.max(angle);
         if angle > limits.max_overhang_deg + angle_tol {
             lean.add(angle, lines[j]);
@@ -331,8 +330,9 @@ enum Below {
     Unmeasurable,
     /// Nothing printed within reach and not on the bed.
     Unsupported,
-    /// The layer it rests on: its height above it and the XY offset from its bead, mm.
-    Layer { height: f64, offset: f64 },
+    /// The layer it rests on: its height above it, mm, and how far p leans out from the layers
+    /// below, degrees from vertical.
+    Layer { height: f64, lean_deg: f64 },
 }
 
 /// The search for the layer below each point (read-only: shared by the threads).
@@ -467,12 +467,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
                         if !(-0.5..=1.5).contains(&f_line) {
                             continue;
                         }
-                        let (d_end, f) = point_segment_distance(pxy, a2, b2);
-                        let d = if len2 > 0.0 {
-                            ab.perp_dot(pxy - a2).abs() / len2.sqrt()
-                        } else {
-                            d_end
-                        };
+                        let (d, f) = point_segment_distance(pxy, a2, b2);
                         let zq = a.z + (b.z - a.z) * f;
                         // The bead just laid: reached from p along an almost straight stretch of
                         // path. Where the path has come back over itself (the next revolution,
@@ -496,25 +491,29 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
             .filter(|(_, d)| *d <= self.half_bead)
             .map(|(z, _)| *z)
             .fold(f64::NEG_INFINITY, f64::max);
+        let lean = |d: f64, z: f64| d.atan2((p.z - z).max(1e-9)).to_degrees();
         if top_under.is_finite() {
-            let offset = found
+            // The lean: the least of the layers below within reach. A wall that leans leans
+            // alike from each layer under it; a bead laid beside an earlier, thinner one (the
+            // step between the beads of a wall of several, a tie, a base bead crossing under)
+            // while resting on a layer beneath does not lean.
+            let lean_deg = found
                 .iter()
-                .filter(|(z, _)| *z >= top_under - below_tol)
-                .map(|(_, d)| *d)
+                .map(|&(z, d)| lean(d, z))
                 .fold(f64::INFINITY, f64::min);
             Below::Layer {
                 height: p.z - top_under,
-                offset,
+                lean_deg,
             }
         } else if let Some(&(z, d)) = found.iter().min_by(|a, b| a.1.total_cmp(&b.1)) {
             Below::Layer {
                 height: p.z - z,
-                offset: d,
+                lean_deg: lean(d, z),
             }
         } else if p.z <= self.bed_layer {
             Below::Layer {
                 height: p.z,
-                offset: 0.0,
+                lean_deg: 0.0,
             } // on the bed
         } else {
             Below::Unsupported
