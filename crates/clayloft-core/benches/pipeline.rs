@@ -41,6 +41,15 @@ fn pipeline(c: &mut Criterion) {
         })
     });
     g.finish();
+    // Of that, the inner bead alone: 301 sections offset by a line width.
+    let design = parse_design(BIG_DESIGN).unwrap();
+    let surface = clayloft_core::pipeline::build_surface(&design).unwrap();
+    let mut g = c.benchmark_group("walls");
+    g.sample_size(10);
+    g.bench_function("inner_bead_720x300", |b| {
+        b.iter(|| black_box(clayloft_core::walls::inner_beads(&surface, 2, 3.0, None).unwrap()))
+    });
+    g.finish();
 }
 
 /// Base fill of a 100 mm foot (issue 13): a six-point star 100 mm across (outer radius 50 mm,
