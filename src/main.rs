@@ -66,6 +66,9 @@ enum Command {
     },
     /// List the shipped printer profiles (name, bed shape and size, origin, firmware dialect).
     Printers,
+    /// List the clay-body presets of `[clay] body = …` (density, yield stress, stiffening,
+    /// stiffness, firing shrinkage).
+    ClayBodies,
     /// Render the editor's view of a design to a PNG and exit (works under xvfb-run with Mesa).
     Screenshot {
         design: Option<PathBuf>,
@@ -166,6 +169,7 @@ fn main() -> ExitCode {
             printer,
         }) => stl(&design, &out, ascii, printer.as_deref()),
         Some(Command::Printers) => printers(),
+        Some(Command::ClayBodies) => clay_bodies(),
         Some(Command::Check { gcode, design }) => check(&gcode, design.as_deref()),
         Some(Command::Print {
             gcode,
@@ -258,6 +262,28 @@ fn printers() -> Result<ExitCode, Failure> {
     Ok(ExitCode::SUCCESS)
 }
 
+fn clay_bodies() -> Result<ExitCode, Failure> {
+    println!(
+        "{:<12} {:>12} {:>12} {:>15} {:>12} {:>17}",
+        "body", "wet density", "yield stress", "stiffening", "stiffness", "firing shrinkage"
+    );
+    for b in clayloft_core::clay::PRESETS {
+        println!(
+            "{:<12} {:>7.0} kg/m³ {:>9.1} kPa {:>10.2} Pa/s {:>8.0} kPa {:>16.1} %",
+            b.name,
+            b.wet_density,
+            b.yield_stress / 1000.0,
+            b.structuration_rate,
+            b.elastic_modulus / 1000.0,
+            b.firing_shrinkage_percent
+        );
+    }
+    println!(
+        "(printing consistency; where the numbers come from: crates/clayloft-core/src/clay.rs. Measure your paste with a fall cone: [clay] fall_cone_mm = depth)"
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
     let d = &loaded.design;
     let s = summarize(d, job);
@@ -284,6 +310,44 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
         m.min_layer_height,
         m.max_layer_height
     );
+    if let Ok(body) = clayloft_core::clay::resolve(d.clay.as_ref()) {
+        // The printed (wet) size, and what the kiln makes of it.
+        let (lo, hi) = job.surface.sections.iter().flat_map(|s| &s.points).fold(
+            (
+                bevy::math::DVec3::splat(f64::INFINITY),
+                bevy::math::DVec3::splat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let wet = hi - lo + bevy::math::DVec3::new(d.printer.line_width, d.printer.line_width, 0.0);
+        let (sxy, sz) = (
+            1.0 - body.firing_shrinkage_percent / 100.0,
+            1.0 - body.firing_shrinkage_z_percent / 100.0,
+        );
+        let compensated = d.clay.as_ref().is_some_and(|c| c.compensate_shrinkage);
+        println!(
+            "size: {:.1} x {:.1} x {:.1} mm wet, {:.1} x {:.1} x {:.1} mm fired ({}, {} % shrinkage{})",
+            wet.x,
+            wet.y,
+            hi.z,
+            wet.x * sxy,
+            wet.y * sxy,
+            hi.z * sz,
+            body.name,
+            body.firing_shrinkage_percent,
+            if compensated {
+                ", printed enlarged to fire to the designed size"
+            } else {
+                ""
+            }
+        );
+    }
+    if let Ok(p) = clayloft_core::printability::assess(d, &job.toolpath) {
+        println!("{}", p.summary());
+        if let Some(w) = p.warning(d) {
+            println!("{w}");
+        }
+    }
     let findings: Vec<_> = job.findings().collect();
     if findings.is_empty() {
         println!("corrections: none needed");

@@ -312,6 +312,71 @@ fn absurd_sizes_are_bad_input_not_an_exhausted_machine() {
     );
 }
 
+/// Clay bodies (SPEC §14): the presets listed, bad values named, the verdict and the sizes in the
+/// summary, a warning with the minimum layer time for a wall that will not stand.
+#[test]
+fn clay_bodies_printability_and_shrinkage_on_the_command_line() {
+    let out = clayloft(&["clay-bodies"]);
+    assert!(out.status.success());
+    let list = text(&out.stdout);
+    for body in ["stoneware", "porcelain", "earthenware", "terracotta"] {
+        assert!(list.contains(body), "{list}");
+    }
+    bad_design(
+        format!("{GOOD}[clay]\nbody = \"plasticine\"\n").as_bytes(),
+        &["clay.body", "plasticine", "stoneware"],
+    );
+    bad_design(
+        format!("{GOOD}[clay]\nwet_density = -3.0\n").as_bytes(),
+        &["clay.wet_density"],
+    );
+    bad_design(
+        format!("{GOOD}[clay]\nfiring_shrinkage_percent = 55.0\n").as_bytes(),
+        &["clay.firing_shrinkage_percent"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, design: &str| -> String {
+        let path = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&path, design).unwrap();
+        let out = clayloft(&["info", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+    };
+    // The shipped example stands, and says so.
+    let good = run("good", GOOD);
+    assert!(
+        good.contains("printability: safety factor") && !good.contains("warning"),
+        "{good}"
+    );
+    assert!(
+        good.contains("mm wet") && good.contains("mm fired (stoneware, 12 % shrinkage)"),
+        "{good}"
+    );
+    // A tall vessel of a soft porcelain that barely stiffens: it will not stand.
+    let tall = "version = 1\n[printer]\nmax_z = 1000.0\n[shape]\nheight = 400.0\n[shape.lower]\ntype = \"circle\"\nradius = 60.0\n[shape.upper]\ntype = \"circle\"\nradius = 60.0\n[clay]\nbody = \"porcelain\"\nstructuration_rate = 0.05\n";
+    let summary = run("tall", tall);
+    assert!(
+        summary.contains("printability: safety factor 0."),
+        "{summary}"
+    );
+    assert!(
+        summary.contains("warning: the wall will not stand"),
+        "{summary}"
+    );
+    assert!(summary.contains("printer.min_layer_time = "), "{summary}");
+    // Compensated: printed 1/0.88 larger, fired to the designed 80 mm.
+    let comp = run(
+        "comp",
+        &format!("{GOOD}[clay]\ncompensate_shrinkage = true\n")
+            .replace("radius = 30.0", "radius = 40.0"),
+    );
+    assert!(
+        comp.contains("x 68.2 mm wet") && comp.contains("x 60.0 mm fired"),
+        "{comp}"
+    );
+    assert!(comp.contains("printed enlarged"), "{comp}");
+}
+
 /// Wall beads (SPEC §13): out of range, ties without a second bead, a vessel too narrow for them.
 #[test]
 fn bad_wall_beads_exit_2_naming_the_field() {

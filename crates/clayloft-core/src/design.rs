@@ -26,6 +26,9 @@ pub struct Design {
     pub texture: Option<Texture>,
     #[serde(default)]
     pub constraints: Constraints,
+    /// The clay body (SPEC §14): stoneware when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clay: Option<crate::clay::ClayTable>,
     /// Folder that image and SVG contour paths are relative to: the design file's (set by the
     /// loader; not part of the file, not compared).
     #[serde(skip)]

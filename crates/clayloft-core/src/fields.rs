@@ -97,6 +97,20 @@ const fn field(
 /// Every plain number of a design, in form order.
 #[rustfmt::skip]
 pub const FIELDS: &[FieldMeta] = &[
+    field("clay.wet_density", "Wet density", "kg/m³", 1000.0, 3000.0, false,
+        "Mass of a litre of the wet paste, in grams: water is 1000, printing clay about 1850."),
+    field("clay.yield_stress", "Yield stress", "Pa", 0.0, 1e6, true,
+        "Stress the fresh bead carries before it flows: the stiffer the paste, the higher."),
+    field("clay.fall_cone_mm", "Fall-cone depth", "mm", 1.0, 60.0, false,
+        "How far an 80 g, 30° cone sinks into the paste; sets the yield stress (20 mm = liquid limit)."),
+    field("clay.structuration_rate", "Stiffening rate", "Pa/s", 0.0, 1000.0, false,
+        "How fast the laid clay gains strength while it rests (it dries and sets)."),
+    field("clay.elastic_modulus", "Stiffness", "Pa", 0.0, 1e9, true,
+        "Young's modulus of the fresh paste: what keeps a thin wall from buckling."),
+    field("clay.firing_shrinkage_percent", "Firing shrinkage", "%", 0.0, 40.0, false,
+        "How much smaller the fired piece is than the wet print (drying and firing)."),
+    field("clay.firing_shrinkage_z_percent", "Firing shrinkage in height", "%", 0.0, 40.0, false,
+        "Shrinkage in height when it differs from the shrinkage across."),
     field("shape.height", "Height", "mm", 0.0, MAX_LENGTH, true,
         "Height of the vessel from the bed to the rim."),
     field("printer.bed_x", "Bed x", "mm", 0.0, MAX_LENGTH, true, "Bed size along x."),

@@ -276,7 +276,16 @@ impl Session {
     /// complete job, and [`Session::is_current`] is false until an update succeeds.
     pub fn update(&mut self, design: &Design) -> Result<Update, FieldError> {
         self.updates += 1;
-        let result = self.update_stages(design);
+        // The vessel is built at its wet size (SPEC §14: enlarged to fire to the designed size).
+        let wet = crate::clay::wet_design(design);
+        let design = match &wet {
+            Ok(d) => d.as_ref(),
+            Err(_) => design,
+        };
+        let result = match &wet {
+            Ok(_) => self.update_stages(design),
+            Err(e) => Err(e.clone()),
+        };
         match &result {
             Ok(_) => {
                 self.error = None;

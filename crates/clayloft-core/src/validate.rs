@@ -238,6 +238,7 @@ pub fn validate(d: &Design) -> Check {
         ));
     }
     validate_printer(&d.printer)?;
+    crate::clay::resolve(d.clay.as_ref())?;
     let p = &d.printer;
     let s = &d.shape;
     if let Some(m) = &s.mesh {

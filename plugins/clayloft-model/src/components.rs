@@ -76,6 +76,11 @@ impl VesselBeads {
 #[derive(Component, Debug, Clone)]
 pub struct ToolpathPath(pub Arc<Toolpath>);
 
+/// Whether the wet wall of the toolpath stands while it is printed (SPEC §14), on the toolpath
+/// entity: judged once per toolpath by the core.
+#[derive(Component, Debug, Clone)]
+pub struct ToolpathPrintability(pub clayloft_core::printability::Printability);
+
 /// Which kind of control line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum LineKind {

@@ -134,7 +134,9 @@ pub fn handle_frame(
     model: &ShapeModel,
     offsets: &HashMap<ContourRole, DVec2>,
 ) -> Option<HandleFrame> {
-    let height = design.shape.height;
+    // The model is the vessel as printed: enlarged where the clay's shrinkage is compensated.
+    let (_, kz) = clayloft_core::clay::wet_factors(design);
+    let height = design.shape.height * kz;
     match role {
         HandleRole::Contour { contour, param } => {
             let z = if contour == ContourRole::Lower {
@@ -177,7 +179,7 @@ pub fn handle_frame(
             let on_wall = model.wall_point(column, h.at);
             let z_scale = model.hz_scale * model.horizontal.get(line)?.weight_at(h.at);
             Some(HandleFrame {
-                origin: on_wall - DVec3::Z * (z_scale * dz),
+                origin: on_wall - DVec3::Z * (z_scale * dz * kz),
                 dir: DVec2::ZERO,
                 height,
                 z_scale,
@@ -326,28 +328,30 @@ pub fn next_pick(
     }
 }
 
-/// Where the handle of `role` sits (design space), given its frame.
+/// Where the handle of `role` sits (design space, on the vessel as printed: the design's
+/// lengths times [`clayloft_core::clay::wet_factors`]), given its frame.
 pub fn handle_position(role: HandleRole, design: &Design, f: &HandleFrame) -> Option<DVec3> {
+    let (kxy, kz) = clayloft_core::clay::wet_factors(design);
     match role {
         HandleRole::Contour { contour, param } => {
             let spec = contour_spec(design, contour);
             let local = match (spec, param) {
                 (ContourSpec::Spline { points }, ContourParam::Point(i)) => {
                     let [x, y] = *points.get(i)?;
-                    DVec2::new(x, y)
+                    DVec2::new(x, y) * kxy
                 }
-                _ => f.dir * radial_value(spec, param)?,
+                _ => f.dir * radial_value(spec, param)? * kxy,
             };
             Some(f.origin + local.extend(0.0))
         }
         HandleRole::Line { kind, line, point } => match kind {
             LineKind::Vertical => {
                 let [_, offset] = *design.control.vertical.get(line)?.points.get(point)?;
-                Some(f.origin + (f.dir * offset).extend(0.0))
+                Some(f.origin + (f.dir * offset * kxy).extend(0.0))
             }
             LineKind::Horizontal => {
                 let [_, dz] = *design.control.horizontal.get(line)?.points.get(point)?;
-                Some(f.origin + DVec3::Z * (f.z_scale * dz))
+                Some(f.origin + DVec3::Z * (f.z_scale * dz * kz))
             }
         },
     }
@@ -378,9 +382,11 @@ const MIN_RADIUS: f64 = 1.0;
 /// measured in the frame captured when the drag started. Returns false if nothing changed.
 pub fn set_handle(role: HandleRole, design: &mut Design, f: &HandleFrame, target: DVec3) -> bool {
     let before = design.clone();
+    // The target is on the vessel as printed; the design holds the fired size.
+    let (kxy, kz) = clayloft_core::clay::wet_factors(design);
     match role {
         HandleRole::Contour { contour, param } => {
-            let local = target.truncate() - f.origin.truncate();
+            let local = (target.truncate() - f.origin.truncate()) / kxy;
             let spec = contour_spec_mut(design, contour);
             let r = local.dot(f.dir).max(MIN_RADIUS);
             match (spec, param) {
@@ -441,7 +447,7 @@ pub fn set_handle(role: HandleRole, design: &mut Design, f: &HandleFrame, target
                 // the line does not reach (zero weight) the offset cannot be dragged.
                 let along = f.dir.length_squared();
                 let offset = if along > 1e-12 {
-                    (target.truncate() - f.origin.truncate()).dot(f.dir) / along
+                    (target.truncate() - f.origin.truncate()).dot(f.dir) / along / kxy
                 } else {
                     v.points[point][1]
                 };
@@ -454,7 +460,7 @@ pub fn set_handle(role: HandleRole, design: &mut Design, f: &HandleFrame, target
                 if let Some(p) = h.points.get_mut(point)
                     && f.z_scale > 1e-12
                 {
-                    p[1] = round3((target.z - f.origin.z) / f.z_scale);
+                    p[1] = round3((target.z - f.origin.z) / f.z_scale / kz);
                 }
             }
         },

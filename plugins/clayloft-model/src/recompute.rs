@@ -152,9 +152,19 @@ pub fn recompute_model(
     if update.toolpath
         && let Some(path) = session.toolpath()
     {
-        commands
-            .entity(*toolpath)
-            .insert(ToolpathPath(Arc::clone(path)));
+        let mut e = commands.entity(*toolpath);
+        e.insert(ToolpathPath(Arc::clone(path)));
+        match session
+            .design()
+            .map(|d| clayloft_core::printability::assess(d, path))
+        {
+            Some(Ok(p)) => {
+                e.insert(ToolpathPrintability(p));
+            }
+            _ => {
+                e.remove::<ToolpathPrintability>();
+            }
+        }
     }
     log.passes += 1;
     log.resampled = resampled;

@@ -63,7 +63,7 @@ fn draw_panels(
     (mut replay, replay_path): (ResMut<Replay>, Res<ReplayPath>),
     wall: Res<WallStats>,
     vessel: Query<&VesselSurface>,
-    toolpath: Query<&ToolpathPath>,
+    toolpath: Query<(&ToolpathPath, Option<&ToolpathPrintability>)>,
     selection: Res<Selection>,
     (mut panel, mut frame): (ResMut<PanelInUse>, MessageWriter<FrameVessel>),
     (mut path_figures, hint, mut hint_since): (
@@ -173,7 +173,7 @@ fn draw_panels(
 
     egui::Panel::bottom("status line").show(&mut root, |ui| {
         ui.horizontal_wrapped(|ui| {
-            if let (Some(s), Some(tp)) = (vessel.iter().next(), toolpath.iter().next()) {
+            if let (Some(s), Some((tp, _))) = (vessel.iter().next(), toolpath.iter().next()) {
                 // Length and time walk the whole path: once per toolpath, not once per frame.
                 let key = std::sync::Arc::as_ptr(&tp.0) as usize;
                 if path_figures.0 != key {
@@ -241,13 +241,12 @@ fn draw_panels(
                 replay_panel(ui, &mut edited, &replay_path);
                 replay.set_if_neq(edited);
                 ui.separator();
-                findings_panel(
-                    ui,
-                    vessel.iter().next(),
-                    toolpath.iter().next(),
-                    &design,
-                    &status,
-                );
+                let (path, verdict) = toolpath.iter().next().unzip();
+                findings_panel(ui, vessel.iter().next(), path, &design, &status);
+                if let Some(p) = verdict.flatten() {
+                    ui.separator();
+                    printability_panel(ui, &p.0, &design, &status);
+                }
             });
         });
 
@@ -416,6 +415,57 @@ fn findings_panel(
     }
 }
 
+/// Will the wet wall stand while it is printed: the core's verdict in words (SPEC §14).
+fn printability_panel(
+    ui: &mut egui::Ui,
+    p: &clayloft_core::printability::Printability,
+    design: &clayloft_core::Design,
+    status: &ModelStatus,
+) {
+    ui.heading("Will it stand?");
+    ui.label(
+        egui::RichText::new(format!(
+            "Wet {} is soft: the layers low in the wall carry all the clay above them while they are still stiffening. A safety factor above 1 means they hold.",
+            p.body.name
+        ))
+        .small()
+        .weak(),
+    );
+    if status.is_stale() {
+        return;
+    }
+    let color = if p.factor >= 1.5 {
+        egui::Color32::from_rgb(150, 220, 150)
+    } else if p.factor >= 1.0 {
+        egui::Color32::from_rgb(240, 200, 90)
+    } else {
+        egui::Color32::from_rgb(255, 90, 90)
+    };
+    ui.colored_label(
+        color,
+        format!(
+            "safety factor {:.2} against {} at layer {} (z {:.1} mm), when layer {} is laid",
+            p.factor,
+            p.mechanism.name(),
+            p.layer,
+            p.z,
+            p.loaded_by
+        ),
+    );
+    match p.warning(design) {
+        Some(w) => {
+            ui.colored_label(egui::Color32::from_rgb(255, 90, 90), w);
+        }
+        None => {
+            ui.label(format!(
+                "It stands. Were it to fail, it would be by {}: {}.",
+                p.mechanism.name(),
+                p.mechanism.explanation()
+            ));
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -434,6 +484,37 @@ mod tests {
         Harness::builder()
             .with_size(egui::vec2(320.0, 600.0))
             .build_ui(move |ui| findings_panel(ui, Some(&surface), Some(&path), &design, &status))
+    }
+
+    /// The verdict in words: a vessel that stands, and a tall soft one that does not (with what
+    /// would help).
+    #[test]
+    fn the_printability_panel_says_whether_the_wall_stands_and_why() {
+        let verdict = |extra: &str, height: f64| {
+            let design = clayloft_core::load::parse_design(&format!(
+                "version = 1\n[printer]\nmax_z = 1000.0\n[shape]\nheight = {height}\nlower = {{ type = \"circle\", radius = 60.0 }}\nupper = {{ type = \"circle\", radius = 60.0 }}\n{extra}"
+            ))
+            .unwrap();
+            let job = clayloft_core::run(&design).unwrap();
+            let p = clayloft_core::printability::assess(&design, &job.toolpath).unwrap();
+            let mut h = Harness::builder()
+                .with_size(egui::vec2(320.0, 600.0))
+                .build_ui(move |ui| printability_panel(ui, &p, &design, &ModelStatus::default()));
+            h.run();
+            h
+        };
+        let h = verdict("", 60.0);
+        assert!(h.query_by_label_contains("is laid").is_some());
+        assert!(h.query_by_label_contains("It stands.").is_some());
+        let h = verdict(
+            "[clay]\nbody = \"porcelain\"\nstructuration_rate = 0.05\n",
+            400.0,
+        );
+        assert!(
+            h.query_by_label_contains("warning: the wall will not stand")
+                .is_some()
+        );
+        assert!(h.query_by_label_contains("min_layer_time").is_some());
     }
 
     #[test]

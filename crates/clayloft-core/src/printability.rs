@@ -1,0 +1,384 @@
+//! Will the wall stand while it is printed (SPEC §14)? The wet wall is judged along the real
+//! toolpath: every layer's age is the print time since it was laid, its clay stiffens with that
+//! age ([`crate::clay::ClayBody`]), and as each layer j is finished every layer k below it carries
+//! the weight of the wall from its own bottom to the top of layer j. Two ways to fail are
+//! checked, after the published models of layer-by-layer extrusion of yield-stress pastes:
+//!
+//! * **Plastic collapse** (Roussel 2018, *Cem. Concr. Res.* 112:76, eq. for the "layer-by-layer"
+//!   buildability; Perrot et al. 2016, *Mater. Struct.* 49:1213): layer k flows when the vertical
+//!   stress ρ·g·h of the wall above it exceeds its compressive yield strength √3·τ₀(age) (von
+//!   Mises: a uniaxial yield stress is √3 times the shear yield stress). Safety factor
+//!   `F = √3·τ₀(age) / (ρ·g·h)`.
+//! * **Elastic buckling** of the thin wall as an axially compressed cylindrical shell (the
+//!   classical critical stress σ_cr = E·e / (R·√(3(1 − ν²))), Timoshenko & Gere, *Theory of
+//!   Elastic Stability* §11.4; ν = ½ for an incompressible paste, so σ_cr = E·e/(1.5·R)), reduced
+//!   by the NASA SP-8007 (1968) knock-down for imperfect shells,
+//!   γ = 1 − 0.901·(1 − e^{−√(R/e)/16}). Layer k buckles when the stress on it exceeds γ·σ_cr
+//!   with its own stiffness E(age): `F = γ·E(age)·e / (1.5·R·ρ·g·h)`. Suiker (2018, *Int. J.
+//!   Mech. Sci.* 137:145) and Wolfs et al. (2018, *Cem. Concr. Res.* 106:103) treat printed walls
+//!   with stiffness that grows with age the same way; this local check is their simplest form.
+//!
+//! Assumptions, stated so that a teacher can discuss them: the wall is a cylinder of the
+//! layer's own length (R = perimeter / 2π; a star or a flat side is weaker than that) and of the
+//! bead width times the beads of the wall (e); the clay stiffens linearly with age (τ₀ + A·t,
+//! over the first hour or so of a print); the weight is that of a vertical wall (a wall that
+//! flares carries a little more per bead); the base, a solid disc, does not buckle; the
+//! youngest point of each layer (its end) stands for the layer.
+
+use crate::clay::{ClayBody, GRAVITY};
+use crate::design::Design;
+use crate::toolpath::Toolpath;
+use crate::validate::FieldError;
+
+/// Layers judged at most (longer prints are judged in groups of consecutive layers): keeps the
+/// pairwise check and the search for a minimum layer time bounded on any design.
+const MAX_LAYERS: usize = 600;
+/// Longest minimum layer time searched for, s.
+const MAX_LAYER_TIME: f64 = 3600.0;
+
+/// How the wall fails.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mechanism {
+    PlasticCollapse,
+    Buckling,
+}
+
+impl Mechanism {
+    /// Short name for a summary line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mechanism::PlasticCollapse => "plastic collapse",
+            Mechanism::Buckling => "buckling",
+        }
+    }
+
+    /// What it means, in words a student understands.
+    pub fn explanation(self) -> &'static str {
+        match self {
+            Mechanism::PlasticCollapse => {
+                "the soft clay low in the wall is squeezed out sideways by the weight of the wall above it before it has stiffened enough to carry it"
+            }
+            Mechanism::Buckling => {
+                "the wall is too thin and soft for its height: like a sheet of paper stood on end it bends sideways under its own weight and folds"
+            }
+        }
+    }
+}
+
+/// The verdict on a print.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Printability {
+    pub body: ClayBody,
+    /// The lowest safety factor anywhere in the print (≥ 1: it stands).
+    pub factor: f64,
+    pub mechanism: Mechanism,
+    /// The layer that fails first (1-based, as the G-code's layer messages count) and its top, mm.
+    pub layer: usize,
+    pub z: f64,
+    /// The layer whose laying loads it most (1-based).
+    pub loaded_by: usize,
+    /// Below 1: the smallest `printer.min_layer_time` that makes the print stand, s (`None`: none
+    /// up to an hour does).
+    pub min_layer_time_to_stand: Option<f64>,
+}
+
+/// One judged layer (or group of layers).
+#[derive(Debug, Clone, Copy)]
+struct Layer {
+    /// Time it takes, s.
+    duration: f64,
+    /// Bottom and top, m.
+    bottom: f64,
+    top: f64,
+    /// Equivalent shell radius, m (0 for the base).
+    radius: f64,
+    /// First layer (1-based) it stands for.
+    first: usize,
+}
+
+/// Judges the print of `toolpath` in the design's clay body.
+pub fn assess(design: &Design, toolpath: &Toolpath) -> Result<Printability, FieldError> {
+    let body = crate::clay::resolve(design.clay.as_ref())?;
+    let layers = layers_of(design, toolpath);
+    let thickness = design.shape.walls.max(1) as f64 * design.printer.line_width * 1e-3;
+    let mut verdict = weakest(&body, &layers, thickness, 0.0);
+    verdict.min_layer_time_to_stand = if verdict.factor >= 1.0
+        || weakest(&body, &layers, thickness, MAX_LAYER_TIME).factor < 1.0
+    {
+        // It stands already, or no layer time up to an hour saves it.
+        None
+    } else {
+        // The factor grows with every layer's duration: bisect the minimum layer time.
+        let (mut lo, mut hi) = (0.0, MAX_LAYER_TIME);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if weakest(&body, &layers, thickness, mid).factor >= 1.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some(hi)
+    };
+    Ok(verdict)
+}
+
+/// The toolpath's layers (base layers and wall revolutions), grouped to at most [`MAX_LAYERS`].
+fn layers_of(design: &Design, tp: &Toolpath) -> Vec<Layer> {
+    let pts = &tp.points;
+    let walls = design.shape.walls.max(1) as f64;
+    let mut out = Vec::with_capacity(tp.layer_starts.len());
+    let mut bottom = 0.0;
+    for (i, &start) in tp.layer_starts.iter().enumerate() {
+        let end = tp.layer_starts.get(i + 1).copied().unwrap_or(pts.len());
+        if end <= start {
+            continue;
+        }
+        let (mut duration, mut length, mut top) = (0.0, 0.0, f64::MIN);
+        for k in start.max(1)..end {
+            let seg = pts[k - 1].pos.distance(pts[k].pos);
+            duration += seg / pts[k].speed.max(1e-9);
+            length += seg;
+        }
+        for p in &pts[start..end] {
+            top = top.max(p.pos.z);
+        }
+        let base = start < tp.base_points;
+        out.push(Layer {
+            duration,
+            bottom,
+            top: top * 1e-3,
+            radius: if base {
+                0.0
+            } else {
+                length / walls / std::f64::consts::TAU * 1e-3
+            },
+            first: i + 1,
+        });
+        bottom = top * 1e-3;
+    }
+    let group = out.len().div_ceil(MAX_LAYERS).max(1);
+    if group == 1 {
+        return out;
+    }
+    out.chunks(group)
+        .map(|c| Layer {
+            duration: c.iter().map(|l| l.duration).sum(),
+            bottom: c[0].bottom,
+            top: c[c.len() - 1].top,
+            radius: c.iter().map(|l| l.radius).fold(f64::INFINITY, f64::min),
+            first: c[0].first,
+        })
+        .collect()
+}
+
+/// The NASA SP-8007 knock-down factor of a cylinder of radius `r` and wall `e`.
+pub fn knock_down(r: f64, e: f64) -> f64 {
+    1.0 - 0.901 * (1.0 - (-(r / e).sqrt() / 16.0).exp())
+}
+
+/// The lowest safety factor when every layer takes at least `min_layer_time` seconds.
+fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Printability {
+    let rho_g = body.wet_density * GRAVITY;
+    // Time at which each layer is finished.
+    let mut done = Vec::with_capacity(layers.len());
+    let mut t = 0.0;
+    for l in layers {
+        t += l.duration.max(min_layer_time);
+        done.push(t);
+    }
+    let mut worst = Printability {
+        body: *body,
+        factor: f64::INFINITY,
+        mechanism: Mechanism::PlasticCollapse,
+        layer: 1,
+        z: 0.0,
+        loaded_by: 1,
+        min_layer_time_to_stand: None,
+    };
+    for (j, top) in layers.iter().enumerate() {
+        for (k, l) in layers[..=j].iter().enumerate() {
+            let h = top.top - l.bottom;
+            if h <= 0.0 {
+                continue;
+            }
+            let age = done[j] - done[k];
+            let stress = rho_g * h;
+            let collapse = 3f64.sqrt() * body.yield_stress_at(age) / stress;
+            let buckling = if l.radius > 0.0 {
+                knock_down(l.radius, e) * body.elastic_modulus_at(age) * e
+                    / (1.5 * l.radius * stress)
+            } else {
+                f64::INFINITY
+            };
+            let (f, m) = if buckling < collapse {
+                (buckling, Mechanism::Buckling)
+            } else {
+                (collapse, Mechanism::PlasticCollapse)
+            };
+            if f < worst.factor {
+                worst.factor = f;
+                worst.mechanism = m;
+                worst.layer = l.first;
+                worst.z = l.top * 1e3;
+                worst.loaded_by = top.first;
+            }
+        }
+    }
+    worst
+}
+
+impl Printability {
+    /// The summary line: `printability: safety factor F (mechanism) at layer N, z mm`.
+    pub fn summary(&self) -> String {
+        format!(
+            "printability: safety factor {:.2} ({}) at layer {}, z {:.1} mm, when layer {} is laid ({})",
+            self.factor,
+            self.mechanism.name(),
+            self.layer,
+            self.z,
+            self.loaded_by,
+            self.body.name
+        )
+    }
+
+    /// Below a factor of 1: the warning, what happens and what would help.
+    pub fn warning(&self, design: &Design) -> Option<String> {
+        if self.factor >= 1.0 {
+            return None;
+        }
+        let time = match self.min_layer_time_to_stand {
+            Some(t) => format!(
+                "print slower or let each layer stiffen longer (printer.min_layer_time = {:.0} s makes it stand; now {} s)",
+                t.ceil(),
+                design.printer.min_layer_time
+            ),
+            None => "no minimum layer time up to an hour makes it stand".into(),
+        };
+        let walls = if design.shape.walls < crate::walls::MAX_WALLS {
+            format!(
+                "; a thicker wall (shape.walls = {})",
+                design.shape.walls + 1
+            )
+        } else {
+            String::new()
+        };
+        Some(format!(
+            "warning: the wall will not stand: {}. What would help: {time}{walls}; a stiffer paste (less water: a higher clay.yield_stress); or a lower vessel",
+            self.mechanism.explanation()
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::parse_design;
+
+    fn cylinder(height: f64, radius: f64, extra: &str) -> Design {
+        parse_design(&format!(
+            "version = 1\n[printer]\nmax_z = 1000.0\nbed_x = 400.0\nbed_y = 400.0\n[shape]\nheight = {height}\nsamples = 120\nbase_layers = 1\n[shape.lower]\ntype = \"circle\"\nradius = {radius}\n[shape.upper]\ntype = \"circle\"\nradius = {radius}\n{extra}"
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn the_collapse_factor_is_roussel_s_ratio_for_a_wall_printed_at_once() {
+        // No stiffening, a stiff modulus: only collapse, F = √3·τ₀ / (ρ g H) at the bottom.
+        let d = cylinder(
+            100.0,
+            40.0,
+            "[clay]\nstructuration_rate = 0.0\nelastic_modulus = 1e8\nwet_density = 1900.0\nyield_stress = 2000.0\n",
+        );
+        let job = crate::run(&d).unwrap();
+        let p = assess(&d, &job.toolpath).unwrap();
+        let expected = 3f64.sqrt() * 2000.0 / (1900.0 * GRAVITY * 0.100);
+        assert!(
+            (p.factor - expected).abs() / expected < 1e-6,
+            "{} {expected}",
+            p.factor
+        );
+        assert_eq!(p.mechanism, Mechanism::PlasticCollapse);
+        assert_eq!(p.layer, 1);
+        // Loaded most by the last revolution (the rim reaches the same height).
+        assert!(p.loaded_by + 1 >= job.toolpath.layer_starts.len());
+        // 1.86: it stands.
+        assert!(p.factor > 1.8 && p.warning(&d).is_none());
+    }
+
+    #[test]
+    fn a_tall_soft_vessel_collapses_and_a_minimum_layer_time_saves_it() {
+        let d = cylinder(
+            400.0,
+            60.0,
+            "[clay]\nyield_stress = 2500.0\nstructuration_rate = 0.05\nelastic_modulus = 1e8\n",
+        );
+        let job = crate::run(&d).unwrap();
+        let p = assess(&d, &job.toolpath).unwrap();
+        assert!(p.factor < 1.0, "{}", p.factor);
+        assert_eq!(p.mechanism, Mechanism::PlasticCollapse);
+        let t = p.min_layer_time_to_stand.expect("a layer time saves it");
+        let w = p.warning(&d).unwrap();
+        assert!(
+            w.contains("min_layer_time") && w.contains("squeezed out"),
+            "{w}"
+        );
+        // With that minimum layer time it stands, and just under it it does not.
+        let mut slow = d.clone();
+        slow.printer.min_layer_time = t.ceil();
+        let p2 = assess(&slow, &crate::run(&slow).unwrap().toolpath).unwrap();
+        assert!(p2.factor >= 1.0, "{}", p2.factor);
+        slow.printer.min_layer_time = (t * 0.9).floor();
+        let p3 = assess(&slow, &crate::run(&slow).unwrap().toolpath).unwrap();
+        assert!(p3.factor < 1.0, "{}", p3.factor);
+    }
+
+    #[test]
+    fn a_thin_wide_soft_wall_buckles_and_a_second_bead_more_than_doubles_its_factor() {
+        let clay =
+            "[clay]\nyield_stress = 3000.0\nelastic_modulus = 60000.0\nstructuration_rate = 0.0\n";
+        let d = cylinder(150.0, 90.0, clay);
+        let p = assess(&d, &crate::run(&d).unwrap().toolpath).unwrap();
+        assert_eq!(p.mechanism, Mechanism::Buckling);
+        // F = γ E e / (1.5 R ρ g h) with R = 90 mm, e = 3 mm at the wall's foot.
+        let (r, e, h) = (0.090, 0.003, 0.150 - 0.001);
+        let rho_g = preset_density() * GRAVITY;
+        let expected = knock_down(r, e) * 60000.0 * e / (1.5 * r * rho_g * h);
+        assert!(
+            (p.factor - expected).abs() / expected < 0.02,
+            "{} {expected}",
+            p.factor
+        );
+        let mut two = d.clone();
+        two.shape.walls = 2;
+        let p2 = assess(&two, &crate::run(&two).unwrap().toolpath).unwrap();
+        // Twice the thickness, a shorter inner bead (smaller mean radius): more than twice.
+        assert!(p2.factor > 2.0 * p.factor, "{} {}", p2.factor, p.factor);
+    }
+
+    fn preset_density() -> f64 {
+        crate::clay::preset("stoneware").unwrap().wet_density
+    }
+
+    #[test]
+    fn the_knock_down_follows_sp_8007() {
+        // R/e = 256: √256/16 = 1 → 1 − 0.901·(1 − 1/e) = 0.4305.
+        assert!((knock_down(256.0, 1.0) - 0.4305).abs() < 1e-4);
+        assert!(knock_down(1.0, 1.0) > 0.9);
+    }
+
+    #[test]
+    fn a_long_print_is_judged_in_bounded_time() {
+        // 0.1 mm layers, 3000 of them: grouped to 600.
+        let d = parse_design(
+            "version = 1\n[printer]\nmax_z = 1000.0\nlayer_height = 0.1\nmin_layer_height = 0.05\nmax_layer_height = 0.2\nline_width = 1.0\nnozzle_diameter = 1.0\n[shape]\nheight = 300.0\nsamples = 60\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n",
+        )
+        .unwrap();
+        let job = crate::run(&d).unwrap();
+        assert!(job.toolpath.layer_starts.len() > 2900);
+        let start = std::time::Instant::now();
+        let p = assess(&d, &job.toolpath).unwrap();
+        assert!(p.factor.is_finite());
+        assert!(start.elapsed().as_secs() < 20);
+    }
+}
