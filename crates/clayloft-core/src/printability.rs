@@ -80,6 +80,23 @@ pub struct Printability {
     /// Below 1: the smallest `printer.min_layer_time` that makes the print stand, s (`None`: none
     /// up to an hour does).
     pub min_layer_time_to_stand: Option<f64>,
+    /// Each judged layer's top, mm, and its own lowest safety factor over the print, bottom up
+    /// (for colouring the wall).
+    pub layer_factors: Vec<(f64, f64)>,
+}
+
+impl Printability {
+    /// The lowest safety factor of the layer at height `z`, mm (the layer whose top is the first
+    /// at or above it).
+    pub fn factor_at(&self, z: f64) -> f64 {
+        let i = self
+            .layer_factors
+            .partition_point(|&(top, _)| top < z - 1e-9);
+        self.layer_factors
+            .get(i)
+            .or(self.layer_factors.last())
+            .map_or(f64::INFINITY, |&(_, f)| f)
+    }
 }
 
 /// One judged layer (or group of layers).
@@ -195,6 +212,10 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
         z: 0.0,
         loaded_by: 1,
         min_layer_time_to_stand: None,
+        layer_factors: layers
+            .iter()
+            .map(|l| (l.top * 1e3, f64::INFINITY))
+            .collect(),
     };
     for (j, top) in layers.iter().enumerate() {
         for (k, l) in layers[..=j].iter().enumerate() {
@@ -216,6 +237,8 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
             } else {
                 (collapse, Mechanism::PlasticCollapse)
             };
+            let own = &mut worst.layer_factors[k].1;
+            *own = own.min(f);
             if f < worst.factor {
                 worst.factor = f;
                 worst.mechanism = m;
@@ -304,6 +327,11 @@ mod tests {
         assert!(p.loaded_by + 1 >= job.toolpath.layer_starts.len());
         // 1.86: it stands.
         assert!(p.factor > 1.8 && p.warning(&d).is_none());
+        // The foot carries the most: its factor is the print's, the rim's is far higher.
+        assert_eq!(p.factor_at(0.5), p.factor);
+        assert!(p.factor_at(99.0) > 10.0 * p.factor);
+        let f: Vec<f64> = p.layer_factors.iter().map(|l| l.1).collect();
+        assert!(f.windows(2).all(|w| w[1] >= w[0]), "bottom up, rising");
     }
 
     #[test]

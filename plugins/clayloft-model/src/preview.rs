@@ -43,6 +43,35 @@ pub fn lean_color(lean: f32, limit: f32) -> [f32; 4] {
     ]
 }
 
+/// Colour of a wall layer whose safety factor against collapse or buckling is `f` (SPEC §14):
+/// clay where it holds with margin (F ≥ 2), through amber towards 1, red where it fails.
+pub fn safety_color(f: f64) -> [f32; 4] {
+    let clay = [0.80, 0.52, 0.38];
+    let amber = [0.95, 0.75, 0.20];
+    let red = [0.90, 0.08, 0.08];
+    if f < 1.0 {
+        return [red[0], red[1], red[2], 1.0];
+    }
+    let w = ((2.0 - f) as f32).clamp(0.0, 1.0);
+    let mix = |a: f32, b: f32| a + (b - a) * w;
+    [
+        mix(clay[0], amber[0]),
+        mix(clay[1], amber[1]),
+        mix(clay[2], amber[2]),
+        1.0,
+    ]
+}
+
+impl WallBuffers {
+    /// Recolours the wall by the safety factor of each vertex's layer.
+    pub fn colour_by_safety(&mut self, p: &clayloft_core::printability::Printability) {
+        for (c, pos) in self.colors.iter_mut().zip(&self.positions) {
+            // World y is the design's z.
+            *c = safety_color(p.factor_at(pos[1] as f64));
+        }
+    }
+}
+
 /// Builds the wall buffers: one vertex per surface point, two triangles per quad between
 /// consecutive sections (closed around), normals from central differences. With an `innermost`
 /// bead (a wall of several beads, SPEC §13) its sheet follows, facing inward and coloured by the
@@ -180,6 +209,31 @@ mod tests {
         assert!(close(lean_color(20.0, 45.0), [0.80, 0.52, 0.38, 1.0]));
         assert!(close(lean_color(45.0, 45.0), [0.95, 0.75, 0.20, 1.0]));
         assert!(close(lean_color(50.0, 45.0), [0.90, 0.08, 0.08, 1.0]));
+    }
+
+    #[test]
+    fn a_wall_that_fails_is_red_at_its_foot_and_clay_at_its_rim() {
+        assert_eq!(safety_color(0.9), [0.90, 0.08, 0.08, 1.0]);
+        assert_eq!(safety_color(2.5), [0.80, 0.52, 0.38, 1.0]);
+        assert_eq!(safety_color(1.0), [0.95, 0.75, 0.20, 1.0]);
+        let d = clayloft_core::load::parse_design(
+            "version = 1\n[printer]\nmax_z = 1000.0\n[shape]\nheight = 400.0\nsamples = 60\n\
+             lower = { type = \"circle\", radius = 60.0 }\nupper = { type = \"circle\", radius = 60.0 }\n\
+             [clay]\nbody = \"porcelain\"\nstructuration_rate = 0.05\n",
+        )
+        .unwrap();
+        let job = clayloft_core::run(&d).unwrap();
+        let p = clayloft_core::printability::assess(&d, &job.toolpath).unwrap();
+        assert!(p.factor < 1.0);
+        let mut b = wall_buffers(&job.surface, None, 45.0);
+        b.colour_by_safety(&p);
+        let n = 60;
+        assert_eq!(b.colors[n], safety_color(0.0), "the foot fails");
+        assert_eq!(
+            b.colors[b.colors.len() - 1],
+            safety_color(10.0),
+            "the rim holds"
+        );
     }
 
     #[test]

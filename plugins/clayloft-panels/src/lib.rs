@@ -160,6 +160,8 @@ fn draw_panels(
             ui.checkbox(&mut shown.show_toolpath, "toolpath");
             ui.checkbox(&mut shown.show_control_lines, "control lines");
             ui.checkbox(&mut shown.show_build_volume, "build volume");
+            ui.checkbox(&mut shown.colour_by_safety, "safety colours")
+                .on_hover_text("Colour the wall by whether it stands while printing (red: it fails) instead of by its lean");
             settings.set_if_neq(shown);
             if ui
                 .button("Frame vessel")
@@ -425,7 +427,7 @@ fn printability_panel(
     ui.heading("Will it stand?");
     ui.label(
         egui::RichText::new(format!(
-            "Wet {} is soft: the layers low in the wall carry all the clay above them while they are still stiffening. A safety factor above 1 means they hold.",
+            "Wet {} is soft: the layers low in the wall carry all the clay above them while they are still stiffening. A safety factor above 1 means they hold (tick \"safety colours\" to see it on the wall: red fails, amber is close).",
             p.body.name
         ))
         .small()

@@ -17,6 +17,8 @@ pub struct ViewSettings {
     pub show_toolpath: bool,
     pub show_control_lines: bool,
     pub show_build_volume: bool,
+    /// Colour the wall by its safety factor while printing (SPEC §14) instead of its lean.
+    pub colour_by_safety: bool,
 }
 
 impl Default for ViewSettings {
@@ -26,6 +28,7 @@ impl Default for ViewSettings {
             show_toolpath: false,
             show_control_lines: true,
             show_build_volume: true,
+            colour_by_safety: false,
         }
     }
 }
@@ -273,32 +276,49 @@ fn frame_camera_on_first_surface(
     *done = true;
 }
 
-/// The vessel's wall, when its surface or its beads changed.
-type ChangedWall<'w, 's> = Query<
+/// The vessel's wall: its surface and beads, with change ticks.
+type Wall<'w, 's> = Query<
     'w,
     's,
-    (&'static VesselSurface, Option<&'static VesselBeads>),
-    Or<(Changed<VesselSurface>, Changed<VesselBeads>)>,
+    (
+        Ref<'static, VesselSurface>,
+        Option<Ref<'static, VesselBeads>>,
+    ),
 >;
 
 fn rebuild_wall_mesh(
-    vessel: ChangedWall,
-    doc: Option<Res<DesignDoc>>,
+    vessel: Wall,
+    verdict: Query<Ref<ToolpathPrintability>>,
+    (settings, doc): (Res<ViewSettings>, Option<Res<DesignDoc>>),
     wall: Single<&Mesh3d, With<WallView>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut stats: ResMut<WallStats>,
     mut rebuilds: ResMut<ViewRebuilds>,
+    mut coloured_by_safety: Local<bool>,
 ) {
     let (Some((surface, beads)), Some(doc)) = (vessel.iter().next(), doc) else {
         return;
     };
+    let verdict = verdict.iter().next();
+    let by_safety = settings.colour_by_safety && verdict.is_some();
+    let changed = surface.is_changed()
+        || beads.as_ref().is_some_and(|b| b.is_changed())
+        || (by_safety && verdict.as_ref().is_some_and(|v| v.is_changed()))
+        || by_safety != *coloured_by_safety;
+    if !changed {
+        return;
+    }
+    *coloured_by_safety = by_safety;
     rebuilds.wall_mesh += 1;
-    let buffers = wall_buffers(
+    let mut buffers = wall_buffers(
         &surface.0,
-        beads.and_then(VesselBeads::innermost),
+        beads.as_deref().and_then(VesselBeads::innermost),
         doc.design.printer.max_overhang_deg,
     );
     stats.violating_points = buffers.violating;
+    if by_safety && let Some(v) = verdict {
+        buffers.colour_by_safety(&v.0);
+    }
     let _ = meshes.insert(wall.0.id(), buffers.into_mesh());
 }
 
