@@ -375,6 +375,15 @@ fn clay_bodies_printability_and_shrinkage_on_the_command_line() {
         "{comp}"
     );
     assert!(comp.contains("printed enlarged"), "{comp}");
+    // Ribs that turn 28 mm round per layer, printed without enforcement: beads with nothing
+    // under them for longer than stoneware spans.
+    let ribs = "version = 1\n[shape]\nheight = 30.0\nsamples = 360\nbase_layers = 0\n[shape.lower]\ntype = \"circle\"\nradius = 40.0\n[shape.upper]\ntype = \"circle\"\nradius = 40.0\n[texture]\ncombine = \"sum\"\nphase_drift = 40.0\n[texture.x]\nwave = \"square\"\nperiod = 90\namplitude = 4.0\n[constraints]\nenforce = false\n";
+    let droop = run("ribs", ribs);
+    assert!(
+        droop.contains("droop: layer") && droop.contains("it will sag"),
+        "{droop}"
+    );
+    assert!(!good.contains("droop"), "{good}");
 }
 
 /// Wall beads (SPEC §13): out of range, ties without a second bead, a vessel too narrow for them.

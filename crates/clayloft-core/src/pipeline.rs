@@ -118,7 +118,11 @@ pub fn finish_sections(
     findings.extend(correct_shape(design, &mut sections, 1));
     if let Some(tex) = &design.texture {
         let enforce = design.constraints.enforce;
-        let tan = overhang_tan_limit(design);
+        // The overhang limit, and never a bead wholly beside the one below it (half a bead out
+        // per layer: beyond that a texture's stretch of bead has nothing under it and droops,
+        // SPEC §14; only a printer set steeper than about 56° reaches it).
+        let tan = overhang_tan_limit(design)
+            .min(0.5 * design.printer.line_width / grid.layer_pitch.max(1e-9));
         let events = match displacements {
             Some(disp) => apply_displacements(&mut sections, disp, tan, enforce),
             None => apply_texture(&mut sections, tex, tan, enforce),

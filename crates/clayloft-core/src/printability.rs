@@ -293,6 +293,111 @@ impl Printability {
     }
 }
 
+/// A stretch of one layer whose bead has nothing under it for longer than the clay can span
+/// (SPEC §14, the paper's §5 "drooping of the print path" under large texture amplitudes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Droop {
+    /// The section (layer) it is on and its height, mm.
+    pub layer: usize,
+    pub z: f64,
+    /// Length of the longest unsupported stretch there, mm, and the longest the body spans.
+    pub length: f64,
+    pub limit: f64,
+}
+
+/// Longest stretch of fresh bead, mm, that spans a gap with nothing under it: a beam of the
+/// bead's own weight supported at both ends (the bead on either side rests on the layer below),
+/// bending stress at its middle 6·q·L²/(8·w·h²) = ¾·ρ·g·L²/h against the compressive yield
+/// strength √3·τ₀ at deposition: L = √(4·√3·τ₀·h / (3·ρ·g)). A 1 mm layer of stoneware (3 kPa)
+/// spans about 19 mm.
+pub fn span_limit(body: &ClayBody, layer_height_mm: f64) -> f64 {
+    let h = layer_height_mm * 1e-3;
+    (4.0 * 3f64.sqrt() * body.yield_stress * h / (3.0 * body.wet_density * GRAVITY)).sqrt() * 1e3
+}
+
+/// The layers of `surface` where a bead lies wholly beside the one below it (its centre more
+/// than half a bead width from the layer below) along a stretch longer than [`span_limit`]: a
+/// texture or a lean the printer's overhang limit lets through but the clay does not hold.
+/// With enforcement the texture is lowered where it would put a bead half a width out (see
+/// [`crate::pipeline::finish_sections`]), and within the default 45° limit no lean does; a design
+/// printed without enforcement, or a printer set steeper than about 56° with a steep shape, can
+/// still droop.
+pub fn droops(
+    design: &Design,
+    surface: &crate::pipeline::Surface,
+) -> Result<Vec<Droop>, FieldError> {
+    let body = crate::clay::resolve(design.clay.as_ref())?;
+    let half = 0.5 * design.printer.line_width;
+    let limit = span_limit(&body, surface.layer_pitch);
+    let sections = &surface.sections;
+    let mut out = Vec::new();
+    for k in 2..sections.len() {
+        let (below, here) = (sections[k - 1].xy(), sections[k].xy());
+        let n = here.len();
+        if n < 3 || below.len() != n {
+            continue;
+        }
+        // Nearest point of the layer below, searched near the same column (a texture moves a
+        // point along the normal, never far round the vessel).
+        let window = (n / 16).clamp(4, 64);
+        let free: Vec<bool> = (0..n)
+            .map(|i| {
+                (0..2 * window)
+                    .map(|o| (i + n - window + o) % n)
+                    .map(|j| {
+                        crate::geometry::point_segment_distance(
+                            here[i],
+                            below[j],
+                            below[(j + 1) % n],
+                        )
+                        .0
+                    })
+                    .fold(f64::INFINITY, f64::min)
+                    > half
+            })
+            .collect();
+        if free.iter().all(|&f| f) || !free.iter().any(|&f| f) {
+            // Everywhere (a whole layer out: an overhang, the checker's business) or nowhere.
+            continue;
+        }
+        // The longest run of free points, round the ring from a supported one.
+        let start = free.iter().position(|&f| !f).unwrap_or(0);
+        let (mut run, mut longest) = (0.0, 0.0f64);
+        for s in 1..=n {
+            let (a, b) = ((start + s - 1) % n, (start + s) % n);
+            if free[b] {
+                run += here[a].distance(here[b]);
+            } else {
+                if run > 0.0 {
+                    // The gap reaches to the supported point on either side.
+                    run += here[a].distance(here[b]);
+                }
+                longest = longest.max(run);
+                run = 0.0;
+            }
+        }
+        if longest > limit {
+            out.push(Droop {
+                layer: k,
+                z: sections[k].z_range().1,
+                length: longest,
+                limit,
+            });
+        }
+    }
+    Ok(out)
+}
+
+impl Droop {
+    /// One line for the summary.
+    pub fn summary(&self, body: &str) -> String {
+        format!(
+            "droop: layer {} (z {:.1} mm): {:.1} mm of bead with nothing under it, longer than the {:.1} mm fresh {body} spans; it will sag. Lower the texture amplitude there or keep the overhang limit at 45°",
+            self.layer, self.z, self.length, self.limit
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -386,6 +491,41 @@ mod tests {
 
     fn preset_density() -> f64 {
         crate::clay::preset("stoneware").unwrap().wet_density
+    }
+
+    #[test]
+    fn the_span_limit_is_the_bead_beam_s_and_deep_steep_textures_droop() {
+        let b = crate::clay::preset("stoneware").unwrap();
+        // √(4·√3·3000·0.001 / (3·1878.6·9.80665)) = 19.4 mm.
+        assert!(
+            (span_limit(b, 1.0) - 19.4).abs() < 0.05,
+            "{}",
+            span_limit(b, 1.0)
+        );
+        // A vertical texture 4 mm deep every 6 layers, printed without enforcement on a printer
+        // that allows 70°: whole stretches of bead step more than half a bead out.
+        let texture = "[texture]\ncombine = \"sum\"\nphase_drift = 40.0\n[texture.x]\nwave = \"square\"\nperiod = 90\namplitude = 4.0\n";
+        let steep = |enforce: bool| {
+            let d = parse_design(&format!(
+                "version = 1\n[printer]\nmax_overhang_deg = 70.0\n[shape]\nheight = 30.0\nsamples = 360\nbase_layers = 0\n[shape.lower]\ntype = \"circle\"\nradius = 40.0\n[shape.upper]\ntype = \"circle\"\nradius = 40.0\n{texture}[constraints]\nenforce = {enforce}\n"
+            ))
+            .unwrap();
+            let job = crate::run(&d).unwrap();
+            droops(&d, &job.surface).unwrap()
+        };
+        let found = steep(false);
+        assert!(!found.is_empty());
+        assert!(found.iter().all(|d| d.length > d.limit));
+        assert!(found[0].summary("stoneware").contains("droop: layer"));
+        // Enforced, the texture is lowered so that no bead lies wholly beside the one below.
+        assert!(steep(true).is_empty());
+        // The plain cylinder has none.
+        let d = cylinder(30.0, 40.0, "");
+        assert!(
+            droops(&d, &crate::run(&d).unwrap().surface)
+                .unwrap()
+                .is_empty()
+        );
     }
 
     #[test]
