@@ -50,6 +50,34 @@ fn pipeline(c: &mut Criterion) {
         b.iter(|| black_box(clayloft_core::walls::inner_beads(&surface, 2, 3.0, None).unwrap()))
     });
     g.finish();
+    // The printability verdict (SPEC §14) of the same vessel: 303 layers judged pairwise, and
+    // with a soft porcelain that fails, the bisection for the minimum layer time on top.
+    let job = clayloft_core::run(&design).unwrap();
+    let mut soft = design.clone();
+    soft.clay = Some(clayloft_core::clay::ClayTable {
+        body: Some("porcelain".into()),
+        yield_stress: Some(100.0),
+        structuration_rate: Some(0.1),
+        ..Default::default()
+    });
+    assert!(
+        clayloft_core::printability::assess(&soft, &job.toolpath)
+            .unwrap()
+            .min_layer_time_to_stand
+            .is_some()
+    );
+    let mut g = c.benchmark_group("printability");
+    g.sample_size(10);
+    g.bench_function("assess_720x300", |b| {
+        b.iter(|| black_box(clayloft_core::printability::assess(&design, &job.toolpath).unwrap()))
+    });
+    g.bench_function("assess_720x300_with_min_layer_time", |b| {
+        b.iter(|| black_box(clayloft_core::printability::assess(&soft, &job.toolpath).unwrap()))
+    });
+    g.bench_function("droops_720x300", |b| {
+        b.iter(|| black_box(clayloft_core::printability::droops(&design, &job.surface).unwrap()))
+    });
+    g.finish();
 }
 
 /// Base fill of a 100 mm foot (issue 13): a six-point star 100 mm across (outer radius 50 mm,

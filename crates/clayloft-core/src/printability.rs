@@ -337,24 +337,18 @@ pub fn droops(
         if n < 3 || below.len() != n {
             continue;
         }
-        // Nearest point of the layer below, searched near the same column (a texture moves a
-        // point along the normal, never far round the vessel).
+        // A point is supported when some chord of the layer below comes within half a bead;
+        // searched near the same column (a texture moves a point along the normal, never far
+        // round the vessel), the same column first: almost every point is supported there.
         let window = (n / 16).clamp(4, 64);
-        let free: Vec<bool> = (0..n)
-            .map(|i| {
-                (0..2 * window)
-                    .map(|o| (i + n - window + o) % n)
-                    .map(|j| {
-                        crate::geometry::point_segment_distance(
-                            here[i],
-                            below[j],
-                            below[(j + 1) % n],
-                        )
-                        .0
-                    })
-                    .fold(f64::INFINITY, f64::min)
-                    > half
+        let supported_within = |i: usize, reach: usize| {
+            (0..2 * reach).map(|o| (i + n - reach + o) % n).any(|j| {
+                crate::geometry::point_segment_distance(here[i], below[j], below[(j + 1) % n]).0
+                    <= half
             })
+        };
+        let free: Vec<bool> = (0..n)
+            .map(|i| !supported_within(i, 2) && !supported_within(i, window))
             .collect();
         if free.iter().all(|&f| f) || !free.iter().any(|&f| f) {
             // Everywhere (a whole layer out: an overhang, the checker's business) or nowhere.
