@@ -78,6 +78,24 @@ fn pipeline(c: &mut Criterion) {
         b.iter(|| black_box(clayloft_core::printability::droops(&design, &job.surface).unwrap()))
     });
     g.finish();
+    // The self-check `clayloft gcode` runs on its own file before writing it: parse, then the
+    // layer search (every point against the chords of the layers below).
+    let mut text = Vec::new();
+    write_gcode(&design, &job, &mut text).unwrap();
+    let text = String::from_utf8(text).unwrap();
+    let limits = clayloft_core::check::Limits::from(&design.printer);
+    assert!(
+        clayloft_core::check::check_gcode(&text, &limits)
+            .unwrap()
+            .violations
+            .is_empty()
+    );
+    let mut g = c.benchmark_group("check");
+    g.sample_size(10);
+    g.bench_function("check_gcode_720x300", |b| {
+        b.iter(|| black_box(clayloft_core::check::check_gcode(&text, &limits).unwrap()))
+    });
+    g.finish();
 }
 
 /// Base fill of a 100 mm foot (issue 13): a six-point star 100 mm across (outer radius 50 mm,
