@@ -192,7 +192,10 @@ mod tests {
         // A bad number is named only where the command reads it.
         assert!(parse_moves("M117 Xhello\n").is_ok());
         let e = parse_moves("G1 X1\nG1 Xhello\n").unwrap_err();
-        assert_eq!((e.line, e.message.as_str()), (2, "`Xhello` is not a number"));
+        assert_eq!(
+            (e.line, e.message.as_str()),
+            (2, "`Xhello` is not a number")
+        );
         let e = parse_moves("N3\nfrobnicate\n").unwrap_err();
         assert!(e.message.contains("FROBNICATE"), "{}", e.message);
     }
