@@ -212,9 +212,13 @@ fn measure_layers_in(
         radius
     };
     let chords = chords(v);
+    // Cells twice the near box's half-width across and a reach high: a point's near box spans
+    // 2 × 2 × 2 of them mostly. Measured on the 720 × 300 vase: cells of one half-width and a
+    // band of max_layer_height (3 × 3 × 3) took 245 ms, these 190 ms, three half-widths 212 ms:
+    // each cell visited costs more than the few more chords a larger one holds.
     let mut grid = ChordGrid {
-        cell: near_radius,
-        band: limits.max_layer_height,
+        cell: 2.0 * near_radius,
+        band: reach,
         cells: HashMap::with_hasher(FixedState::default()),
         budget: INSERTIONS_BASE.saturating_add(INSERTIONS_PER_CHORD.saturating_mul(chords.len())),
     };
