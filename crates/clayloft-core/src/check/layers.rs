@@ -19,8 +19,6 @@ const MAX_POINTS_PER_CHORD: usize = 64;
 /// How far a chord may deviate from the points it stands for, mm: below the 1 µm rounding of
 /// G-code coordinates' effect on any measured angle, far below a bead.
 const CHORD_TOLERANCE_MM: f64 = 0.002;
-/// Chords prefiltered at a time (see [`CellChord::may_be_under`]).
-const PREFILTER_CHUNK: usize = 64;
 /// Grid cell insertions allowed in all: a fixed allowance plus this many per chord. A clay
 /// spiral's chords span one or two cells each; a file of segments hundreds of beads long (no
 /// clay print) runs out of budget and is reported as not measurable rather than searched for
@@ -66,25 +64,40 @@ impl CellChord {
 
     /// False only when the chord is surely not beside point `p` along its own direction (the
     /// foot of the perpendicular more than half its length before or after it): the exact test
-    /// allows −0.5 … 1.5, this one −0.6 … 1.6 in single precision, and passes chords under
-    /// 0.1 mm, whose fraction single precision cannot place.
+    /// allows −0.5 … 1.5, this one −0.6 … 1.6 in single precision, and passes chords shorter
+    /// than √`short2` (see [`short_chord2`]), whose fraction single precision cannot place
+    /// within 0.1.
     ///
     /// And false when the chord lies wholly above or below the heights `z` (low, high) a layer
-    /// under the point may have (the bead just laid, mostly). Evaluated without branches.
-    fn may_be_under(&self, p: [f32; 2], z: [f32; 2]) -> bool {
+    /// under the point may have (the bead just laid, mostly).
+    fn may_be_under(&self, p: [f32; 2], z: [f32; 2], short2: f32) -> bool {
         let ab = [self.b[0] - self.a[0], self.b[1] - self.a[1]];
         let len2 = ab[0] * ab[0] + ab[1] * ab[1];
         let dot = (p[0] - self.a[0]) * ab[0] + (p[1] - self.a[1]) * ab[1];
-        let beside = (len2 < 0.01) | ((dot >= -0.6 * len2) & (dot <= 1.6 * len2));
+        let beside = (len2 < short2) | ((dot >= -0.6 * len2) & (dot <= 1.6 * len2));
         beside & (self.z_max >= z[0]) & (self.z_min <= z[1])
     }
+}
+
+/// The squared length below which a chord's single-precision fraction along it is not trusted,
+/// mm², for coordinates up to `extent` mm and spots up to `radius` mm across.
+///
+/// Rounding to single precision moves each coordinate by δ ≤ extent·2⁻²⁴, so the fraction
+/// f = (p − a)·(b − a) / |b − a|² moves by at most about 2δ(|b − a| + |p − a|) / |b − a|²; for a
+/// chord the point may rest on, |p − a| ≤ 1.5·|b − a| + radius. That stays within the 0.1 of
+/// slack when |b − a| ≥ 50δ + √(20δ·radius) (twice that, for the rounding of the arithmetic),
+/// and never below 0.1 mm.
+fn short_chord2(extent: f64, radius: f64) -> f32 {
+    let delta = extent.abs() * 2f64.powi(-24);
+    let len = (2.0 * (50.0 * delta + (20.0 * delta * radius).sqrt())).max(0.1);
+    (len * len) as f32
 }
 
 /// Spatial hash of path chords in (x, y, z-band) cells.
 struct ChordGrid {
     cell: f64,
     band: f64,
-    /// Chord ids per cell, ascending (chords are inserted in path order).
+    /// Chords per cell, ids ascending (chords are inserted in path order).
     cells: HashMap<CellKey, Vec<CellChord>, FixedState>,
     /// Insertions left before the grid gives up (see [`INSERTIONS_PER_CHORD`]).
     budget: usize,
@@ -244,6 +257,10 @@ fn measure_layers_in(
         grid: &grid,
         radius,
         near_radius,
+        short2: short_chord2(
+            limits.bed_x.max(limits.bed_y).max(limits.max_z) + margin,
+            radius,
+        ),
         gap,
         below_tol,
         reach,
@@ -466,6 +483,8 @@ struct LayerSearch<'a, F: Fn(DVec3) -> bool + Sync> {
     radius: f64,
     /// The first, smaller search box's half-width, mm (see [`LayerSearch::point`]).
     near_radius: f64,
+    /// See [`short_chord2`].
+    short2: f32,
     gap: f64,
     below_tol: f64,
     reach: f64,
@@ -603,53 +622,48 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
                 return None;
             }
             *budget -= cell.len();
-            // Most candidates are rejected on their single-precision copy, without a branch per
-            // chord: the survivors' ids are gathered, then measured exactly.
-            for chunk in cell.chunks(PREFILTER_CHUNK) {
-                let mut kept = [0u32; PREFILTER_CHUNK];
-                let mut n = 0;
-                for c in chunk {
-                    kept[n] = c.id;
-                    n += c.may_be_under(p32, z32) as usize;
+            for c in cell {
+                // Most candidates are rejected on their single-precision copy, without reading
+                // the path.
+                if !c.may_be_under(p32, z32, self.short2) {
+                    continue;
                 }
-                for &id in &kept[..n] {
-                    let (ia, ib) = self.chords[id as usize];
-                    let (a, b) = (self.v[ia], self.v[ib]);
-                    // Distance across the segment's line, for feet of the perpendicular on the
-                    // segment or just past its ends; a segment entirely ahead of or behind p along
-                    // its own direction is beside p, not under it.
-                    let (a2, b2) = (a.truncate(), b.truncate());
-                    let ab = b2 - a2;
-                    let len2 = ab.length_squared();
-                    // A steep segment (rising more than it runs) is a step between layers, not a
-                    // layer to rest on.
-                    if (b.z - a.z).powi(2) > len2 {
-                        continue;
-                    }
-                    let f_line = if len2 > 0.0 {
-                        (pxy - a2).dot(ab) / len2
-                    } else {
-                        0.0
-                    };
-                    if !(-0.5..=1.5).contains(&f_line) {
-                        continue;
-                    }
-                    let (d, f) = point_segment_distance(pxy, a2, b2);
-                    if d > radius {
-                        continue;
-                    }
-                    let zq = a.z + (b.z - a.z) * f;
-                    // The bead just laid: reached from p along an almost straight stretch of path.
-                    // Where the path has come back over itself (the next revolution, the centre of
-                    // a spiral base) the layer below is much nearer in XY than along the path.
-                    let cum = self.cum;
-                    let along = cum[j] - (cum[ia] + f * (cum[ib] - cum[ia]));
-                    if along < self.gap && d >= 0.5 * along {
-                        continue;
-                    }
-                    if zq <= z_hi && zq >= z_lo {
-                        found.add(p.z, zq, d, self.half_bead);
-                    }
+                let (ia, ib) = self.chords[c.id as usize];
+                let (a, b) = (self.v[ia], self.v[ib]);
+                // Distance across the segment's line, for feet of the perpendicular on the
+                // segment or just past its ends; a segment entirely ahead of or behind p along
+                // its own direction is beside p, not under it.
+                let (a2, b2) = (a.truncate(), b.truncate());
+                let ab = b2 - a2;
+                let len2 = ab.length_squared();
+                // A steep segment (rising more than it runs) is a step between layers, not a
+                // layer to rest on.
+                if (b.z - a.z).powi(2) > len2 {
+                    continue;
+                }
+                let f_line = if len2 > 0.0 {
+                    (pxy - a2).dot(ab) / len2
+                } else {
+                    0.0
+                };
+                if !(-0.5..=1.5).contains(&f_line) {
+                    continue;
+                }
+                let (d, f) = point_segment_distance(pxy, a2, b2);
+                if d > radius {
+                    continue;
+                }
+                let zq = a.z + (b.z - a.z) * f;
+                // The bead just laid: reached from p along an almost straight stretch of path.
+                // Where the path has come back over itself (the next revolution, the centre of
+                // a spiral base) the layer below is much nearer in XY than along the path.
+                let cum = self.cum;
+                let along = cum[j] - (cum[ia] + f * (cum[ib] - cum[ia]));
+                if along < self.gap && d >= 0.5 * along {
+                    continue;
+                }
+                if zq <= z_hi && zq >= z_lo {
+                    found.add(p.z, zq, d, self.half_bead);
                 }
             }
         }
@@ -699,6 +713,32 @@ mod tests {
             measure_layers_in(&v, &lines, &limits, &mut near, true);
             measure_layers_in(&v, &lines, &limits, &mut whole, false);
             prop_assert_eq!(&near, &whole);
+        }
+    }
+
+    proptest! {
+        /// The single-precision prefilter never rejects a chord the exact test keeps: chords
+        /// 0.01 … 20 mm long anywhere on a 2 m machine, points up to `radius` across with the
+        /// foot of the perpendicular anywhere in −0.5 … 1.5 along it.
+        #[test]
+        fn prefilter_keeps_every_chord_the_exact_test_keeps(
+            ax in 0.0f64..2000.0, ay in 0.0f64..2000.0, az in 0.0f64..2000.0,
+            log_len in -2.0f64..1.3, angle in 0.0f64..std::f64::consts::TAU,
+            f in prop_oneof![Just(-0.5), Just(1.5), -0.5f64..=1.5],
+            across in -1.0f64..=1.0, radius in 1.0f64..60.0,
+        ) {
+            let len = 10f64.powf(log_len);
+            let dir = DVec2::from_angle(angle);
+            let a = DVec3::new(ax, ay, az);
+            let b = a + (dir * len).extend(0.3);
+            let p = a.truncate() + dir * (f * len) + dir.perp() * (across * radius);
+            let exact = (p - a.truncate()).dot(b.truncate() - a.truncate()) / (len * len);
+            // At the ends of the range the exact fraction may round just outside it: skipped.
+            prop_assume!((-0.5..=1.5).contains(&exact));
+            let c = CellChord::new(0, 1, a, b);
+            let z = [(az - 1.0) as f32, (az + 1.0) as f32];
+            let short2 = short_chord2(2000.0 + 2.0 * radius + 10.0, radius);
+            prop_assert!(c.may_be_under([p.x as f32, p.y as f32], z, short2));
         }
     }
 
