@@ -15,13 +15,13 @@ mkdir -p "$out"
 target=${CARGO_TARGET_DIR:-$HOME/.cache/clayloft-target}
 cargo build --release --quiet
 bin="$target/release/clayloft"
-wild="$out/wild.toml.in"
+wild="$out/wild.toml"
 # The benchmark vase pushed past every limit: texture amplitude 6 mm, rose amplitude 20 mm.
 sed -e 's/^amplitude = 0.8/amplitude = 6.0/' -e 's/^amplitude = 8.0/amplitude = 20.0/' \
   assets/benchmarks/vase-720x300.toml > "$wild"
 printf '[constraints]\nenforce = false\n' >> "$wild"
 for f in assets/designs/*.toml assets/benchmarks/*.toml assets/meshes/*.stl "$wild"; do
-  n=$(basename "$f"); n=${n%%.*}
+  n=$(basename "$f"); n=${n%.*}
   gcode="$out/$n.gcode"
   # Each report ends with the command's exit code; the folder is left out of the paths.
   code=0; "$bin" gcode "$f" -o "$gcode" > "$out/$n.gcode.txt" 2>&1 || code=$?
