@@ -79,15 +79,33 @@ struct Ring {
     cum: Vec<f64>,
     /// Spurs into the sharp corners the ring around leaves uncovered: (vertex, tip), by vertex.
     spurs: Vec<(usize, DVec2)>,
+    /// The bounding box (min, max) of each run of [`BLOCK_SEGMENTS`] segments, in order.
+    blocks: Vec<(DVec2, DVec2)>,
 }
+
+/// Segments per bounding box in [`Ring::nearest`]'s search.
+const BLOCK_SEGMENTS: usize = 8;
 
 impl Ring {
     fn new(pts: Vec<DVec2>) -> Ring {
         let cum = crate::geometry::cumulative_length(&pts);
+        let n = pts.len();
+        let blocks = (0..n)
+            .step_by(BLOCK_SEGMENTS)
+            .map(|first| {
+                // Segment i runs from vertex i to vertex i + 1 (the last back to vertex 0).
+                (first..=(first + BLOCK_SEGMENTS).min(n))
+                    .map(|i| pts[i % n])
+                    .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), q| {
+                        (lo.min(q), hi.max(q))
+                    })
+            })
+            .collect();
         Ring {
             pts,
             cum,
             spurs: Vec::new(),
+            blocks,
         }
     }
 
@@ -113,15 +131,37 @@ impl Ring {
         a.lerp(b, f)
     }
 
-    /// Arc length of the ring point nearest to `p`, and its distance.
+    /// Arc length of the ring point nearest to `p`, and its distance (the first segment's, in
+    /// order, where several are as near).
+    ///
+    /// Segments are visited in order, but a run of them whose bounding box lies farther from `p`
+    /// than a distance already known to be reachable is passed over: none of them can be as
+    /// near. The reachable distance starts as the least, over the boxes, of the farthest point
+    /// of a box (every box holds a point of the ring), so that the first runs are already
+    /// pruned. The result is the plain scan's.
     fn nearest(&self, p: DVec2) -> (f64, f64) {
         let n = self.pts.len();
+        let gap = |(lo, hi): (DVec2, DVec2)| (lo - p).max(p - hi).max(DVec2::ZERO).length();
+        let far = |(lo, hi): (DVec2, DVec2)| (p - lo).abs().max((hi - p).abs()).length();
+        let mut reach = self
+            .blocks
+            .iter()
+            .map(|&b| far(b))
+            .fold(f64::INFINITY, f64::min);
         let mut best = (0.0, f64::INFINITY);
-        for i in 0..n {
-            let (d, f) =
-                crate::geometry::point_segment_distance(p, self.pts[i], self.pts[(i + 1) % n]);
-            if d < best.1 {
-                best = (self.cum[i] + f * (self.cum[i + 1] - self.cum[i]), d);
+        for (b, &block) in self.blocks.iter().enumerate() {
+            // Rounding in either distance is far below this margin.
+            if gap(block) > reach + 1e-9 * (1.0 + reach) {
+                continue;
+            }
+            let first = b * BLOCK_SEGMENTS;
+            for i in first..(first + BLOCK_SEGMENTS).min(n) {
+                let (d, f) =
+                    crate::geometry::point_segment_distance(p, self.pts[i], self.pts[(i + 1) % n]);
+                if d < best.1 {
+                    best = (self.cum[i] + f * (self.cum[i + 1] - self.cum[i]), d);
+                    reach = reach.min(d);
+                }
             }
         }
         best
@@ -278,10 +318,60 @@ fn ring_tree(foot: &[DVec2], w: f64) -> Result<Node, FillError> {
     Ok(root)
 }
 
-/// Adds the rings one level inside `node` (exactly `exact`), and theirs, `levels` deep.
-fn grow(node: &mut Node, exact: &Polyline<f64>, w: f64, levels: usize) -> Result<(), FillError> {
+/// Adds the rings one level inside `node` (exactly `exact`), and theirs, `levels` deep, and the
+/// middle rings where no deeper ring reaches.
+///
+/// The middle rings (offsets by w/2) do not depend on the rings inside them, so a second core
+/// offsets them while this one goes down the rings: [`grow_rings`] hands each ring's exact
+/// outline over as it is made, [`add_middles`] puts their offsets in afterwards, in the same
+/// order. The tree is the one made on one core.
+fn grow(root: &mut Node, exact: &Polyline<f64>, w: f64, levels: usize) -> Result<(), FillError> {
+    grow_on(root, exact, w, levels, crate::parallel::cores() > 1)
+}
+
+/// [`grow`], with the middle rings on a second thread or not.
+fn grow_on(
+    root: &mut Node,
+    exact: &Polyline<f64>,
+    w: f64,
+    levels: usize,
+    two_threads: bool,
+) -> Result<(), FillError> {
+    let (send, receive) = std::sync::mpsc::channel::<Polyline<f64>>();
+    let offset_all =
+        move || -> Vec<_> { receive.into_iter().map(|pl| offset(&pl, 0.5 * w)).collect() };
+    let middles = if two_threads && levels > 1 {
+        std::thread::scope(|scope| {
+            let worker = scope.spawn(offset_all);
+            let grown = grow_rings(root, exact, w, levels, &send);
+            drop(send);
+            let middles = crate::parallel::join(worker);
+            grown.map(|()| middles)
+        })?
+    } else {
+        grow_rings(root, exact, w, levels, &send)?;
+        drop(send);
+        offset_all()
+    };
+    add_middles(root, &mut middles.into_iter(), w, levels)
+}
+
+/// The rings one level inside `node` (exactly `exact`), and theirs, `levels` deep; the exact
+/// outline of each ring inside the foot goes to `middles` (depth first, a ring before those
+/// inside it).
+fn grow_rings(
+    node: &mut Node,
+    exact: &Polyline<f64>,
+    w: f64,
+    levels: usize,
+    middles: &std::sync::mpsc::Sender<Polyline<f64>>,
+) -> Result<(), FillError> {
     if levels == 0 {
         return Ok(());
+    }
+    if node.step > 0.0 {
+        // The receiver only goes away once every ring is made.
+        let _ = middles.send(exact.clone());
     }
     for (inner, ring) in offset_exact(exact, w)? {
         let mut child = Node {
@@ -289,24 +379,43 @@ fn grow(node: &mut Node, exact: &Polyline<f64>, w: f64, levels: usize) -> Result
             step: w,
             children: Vec::new(),
         };
-        grow(&mut child, &inner, w, levels - 1)?;
+        grow_rings(&mut child, &inner, w, levels - 1, middles)?;
         node.children.push(child);
     }
-    // The middle of a ring still wider than a bead where no deeper ring reaches (not inside the
-    // foot itself: there the outline's own bead covers the first half bead).
-    if node.step > 0.0 {
-        for half in offset(exact, 0.5 * w)? {
-            let covered = node
-                .children
-                .iter()
-                .any(|c| c.step == w && crate::geometry::contains_point(&half, c.ring.pts[0]));
-            if !covered {
-                node.children.push(Node {
-                    ring: Ring::new(half),
-                    step: 0.5 * w,
-                    children: Vec::new(),
-                });
-            }
+    Ok(())
+}
+
+/// Puts in the middle rings (`middles`: the offsets by w/2 in [`grow_rings`]' order) of each ring
+/// still wider than a bead where no deeper ring reaches (not inside the foot itself: there the
+/// outline's own bead covers the first half bead).
+fn add_middles(
+    node: &mut Node,
+    middles: &mut impl Iterator<Item = Result<Vec<Vec<DVec2>>, FillError>>,
+    w: f64,
+    levels: usize,
+) -> Result<(), FillError> {
+    if levels == 0 {
+        return Ok(());
+    }
+    let mine = if node.step > 0.0 {
+        middles.next().ok_or(FillError::Offset)??
+    } else {
+        Vec::new()
+    };
+    for child in &mut node.children {
+        add_middles(child, middles, w, levels - 1)?;
+    }
+    for half in mine {
+        let covered = node
+            .children
+            .iter()
+            .any(|c| c.step == w && crate::geometry::contains_point(&half, c.ring.pts[0]));
+        if !covered {
+            node.children.push(Node {
+                ring: Ring::new(half),
+                step: 0.5 * w,
+                children: Vec::new(),
+            });
         }
     }
     Ok(())
@@ -344,8 +453,15 @@ fn prune_spurs(root: &mut Node) {
         let pts = &node.ring.pts;
         node.ring.spurs.retain(|&(i, tip)| {
             let base = pts[i];
+            // A segment whose box stays clear of the spur's (with a margin far above the
+            // test's rounding) cannot touch it: most are passed over without the test.
+            let (lo, hi) = (base.min(tip) - 1e-6, base.max(tip) + 1e-6);
             all.iter().all(|&(a, b)| {
-                a == base || b == base || !crate::geometry::segments_intersect(base, tip, a, b)
+                a == base
+                    || b == base
+                    || a.max(b).cmplt(lo).any()
+                    || a.min(b).cmpgt(hi).any()
+                    || !crate::geometry::segments_intersect(base, tip, a, b)
             })
         });
         for c in &mut node.children {
@@ -793,6 +909,43 @@ mod tests {
         check("ellipse", &e);
     }
 
+    /// The ring tree grown with the middle rings on a second thread is the one grown on one.
+    #[test]
+    fn the_ring_tree_does_not_depend_on_the_threads() {
+        let rose: Vec<DVec2> = (0..360)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / 360.0;
+                DVec2::from_angle(t) * (40.0 + 4.0 * (6.0 * t).cos())
+            })
+            .collect();
+        let waist = polygon(
+            &[
+                (0.0, 0.0),
+                (40.0, 0.0),
+                (40.0, 30.0),
+                (22.0, 30.0),
+                (22.0, 8.0),
+                (18.0, 8.0),
+                (18.0, 30.0),
+                (0.0, 30.0),
+            ],
+            240,
+        );
+        for foot in [rose, waist] {
+            let levels = ring_levels(&foot, 3.0);
+            let grown = |two| {
+                let mut root = Node {
+                    ring: Ring::new(foot.clone()),
+                    step: 0.0,
+                    children: Vec::new(),
+                };
+                grow_on(&mut root, &polyline(&foot), 3.0, levels, two).unwrap();
+                format!("{root:?}")
+            };
+            assert_eq!(grown(true), grown(false));
+        }
+    }
+
     #[test]
     fn deep_star() {
         // Six points, outer radius 50, inner 22 (the star): not scaled copies.
@@ -878,6 +1031,44 @@ mod properties {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(40))]
+
+        /// The pruned search finds what the plain scan of every segment finds, to the bit,
+        /// on jagged rings (with repeated points) and points inside, outside and on them.
+        #[test]
+        fn the_nearest_ring_point_is_the_plain_scans(
+            radii in proptest::collection::vec(0.0..50.0f64, 3..200),
+            probes in proptest::collection::vec((-60.0..60.0f64, -60.0..60.0f64), 1..40),
+            on in 0usize..200,
+        ) {
+            let n = radii.len();
+            let mut pts: Vec<DVec2> = radii
+                .iter()
+                .enumerate()
+                .map(|(i, r)| DVec2::from_angle(std::f64::consts::TAU * i as f64 / n as f64) * *r)
+                .collect();
+            if n > 4 {
+                pts[n / 2] = pts[n / 2 - 1];
+            }
+            let ring = Ring::new(pts.clone());
+            let scan = |p: DVec2| {
+                let mut best = (0.0, f64::INFINITY);
+                for i in 0..n {
+                    let (d, f) =
+                        crate::geometry::point_segment_distance(p, pts[i], pts[(i + 1) % n]);
+                    if d < best.1 {
+                        best = (ring.cum[i] + f * (ring.cum[i + 1] - ring.cum[i]), d);
+                    }
+                }
+                best
+            };
+            let mut points: Vec<DVec2> = probes.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
+            points.push(pts[on % n]);
+            points.push(pts[on % n].lerp(pts[(on + 1) % n], 0.5));
+            for p in points {
+                let (a, b) = (ring.nearest(p), scan(p));
+                prop_assert!(a.0.to_bits() == b.0.to_bits() && a.1.to_bits() == b.1.to_bits(), "{p}: {a:?} against {b:?}");
+            }
+        }
         /// Jagged feet (random radius at every vertex, like a noisy tracing or a hand-drawn
         /// splodge) and bead widths: never a panic; either a refusal or one path from and to
         /// point 0 with no step longer than a bridge.

@@ -4,9 +4,11 @@
 
 use std::ops::Range;
 
-/// Threads worth starting for independent work: the machine's cores (1 if unknown).
+/// Threads worth starting for independent work: the machine's cores (1 if unknown), asked once
+/// (on Linux the answer reads the cgroup files, a few system calls each time).
 pub fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
 /// Waits for a scoped thread; a panic in it goes on in the caller (as if it ran there).
@@ -41,12 +43,20 @@ pub fn map_ranges<R: Send>(
         return f(0..len);
     }
     let f = &f;
+    // The last part runs on the calling thread: one thread fewer to start.
+    let (last, others) = parts.split_last().expect("two parts or more");
     std::thread::scope(|scope| {
-        let handles: Vec<_> = parts
-            .into_iter()
-            .map(|r| scope.spawn(move || f(r)))
+        let handles: Vec<_> = others
+            .iter()
+            .map(|r| {
+                let r = r.clone();
+                scope.spawn(move || f(r))
+            })
             .collect();
-        handles.into_iter().flat_map(join).collect()
+        let tail = f(last.clone());
+        let mut out: Vec<R> = handles.into_iter().flat_map(join).collect();
+        out.extend(tail);
+        out
     })
 }
 
@@ -64,11 +74,18 @@ pub fn for_each_part<T: Send>(
     let f = &f;
     let chunk = parts[0].len();
     std::thread::scope(|scope| {
-        let handles: Vec<_> = items
+        let mut chunks: Vec<(usize, &mut [T])> = items
             .chunks_mut(chunk)
             .enumerate()
-            .map(|(j, part)| scope.spawn(move || f(j * chunk, part)))
+            .map(|(j, part)| (j * chunk, part))
             .collect();
+        // The last part runs on the calling thread: one thread fewer to start.
+        let (offset, last) = chunks.pop().expect("two parts or more");
+        let handles: Vec<_> = chunks
+            .into_iter()
+            .map(|(offset, part)| scope.spawn(move || f(offset, part)))
+            .collect();
+        f(offset, last);
         handles.into_iter().for_each(join);
     })
 }
