@@ -217,6 +217,17 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
             .map(|l| (l.top * 1e3, f64::INFINITY))
             .collect(),
     };
+    // Each layer's knock-down factor, once (not once per layer above it).
+    let knock_downs: Vec<f64> = layers
+        .iter()
+        .map(|l| {
+            if l.radius > 0.0 {
+                knock_down(l.radius, e)
+            } else {
+                0.0
+            }
+        })
+        .collect();
     for (j, top) in layers.iter().enumerate() {
         for (k, l) in layers[..=j].iter().enumerate() {
             let h = top.top - l.bottom;
@@ -227,7 +238,7 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
             let stress = rho_g * h;
             let collapse = 3f64.sqrt() * body.yield_stress_at(age) / stress;
             let buckling = if l.radius > 0.0 {
-                knock_down(l.radius, e) * body.elastic_modulus_at(age) * e
+                knock_downs[k] * body.elastic_modulus_at(age) * e
                     / (1.5 * l.radius * stress)
             } else {
                 f64::INFINITY
