@@ -238,8 +238,7 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
             let stress = rho_g * h;
             let collapse = 3f64.sqrt() * body.yield_stress_at(age) / stress;
             let buckling = if l.radius > 0.0 {
-                knock_downs[k] * body.elastic_modulus_at(age) * e
-                    / (1.5 * l.radius * stress)
+                knock_downs[k] * body.elastic_modulus_at(age) * e / (1.5 * l.radius * stress)
             } else {
                 f64::INFINITY
             };

@@ -3,8 +3,6 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::geometry::outward_normals;
-
 /// One ring of surface points, counter-clockwise.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Section {
@@ -17,9 +15,18 @@ impl Section {
         self.points.iter().map(|p| p.truncate()).collect()
     }
 
-    /// Outward unit normals in XY.
+    /// Outward unit normals in XY: [`crate::geometry::outward_normals`] of [`Section::xy`], without making the
+    /// XY copy (the overhang clamp and the metrics ask for every section's).
     pub fn normals(&self) -> Vec<DVec2> {
-        outward_normals(&self.xy())
+        let (p, n) = (&self.points, self.points.len());
+        (0..n)
+            .map(|i| {
+                let before = p[if i == 0 { n - 1 } else { i - 1 }];
+                let after = p[if i + 1 == n { 0 } else { i + 1 }];
+                let d = after.truncate() - before.truncate();
+                DVec2::new(d.y, -d.x).normalize_or_zero()
+            })
+            .collect()
     }
 
     /// Lowest and highest z on the ring.
@@ -29,5 +36,35 @@ impl Section {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
                 (lo.min(p.z), hi.max(p.z))
             })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The same normals, to the bit, as the XY copy's (one, two and many points).
+    #[test]
+    fn normals_are_those_of_the_xy_outline() {
+        for n in [1usize, 2, 3, 7, 360] {
+            let s = Section {
+                points: (0..n)
+                    .map(|i| {
+                        let t = i as f64 * 2.399;
+                        DVec3::new(30.0 * t.cos() + t.sin(), 20.0 * t.sin(), 0.1 * t)
+                    })
+                    .collect(),
+            };
+            let ours: Vec<[u64; 2]> = s
+                .normals()
+                .iter()
+                .map(|v| v.to_array().map(f64::to_bits))
+                .collect();
+            let xy: Vec<[u64; 2]> = crate::geometry::outward_normals(&s.xy())
+                .iter()
+                .map(|v| v.to_array().map(f64::to_bits))
+                .collect();
+            assert_eq!(ours, xy, "{n} points");
+        }
     }
 }

@@ -120,7 +120,13 @@ pub fn wall_buffers(
         for k in 0..rows {
             let (kd, ku) = (k.saturating_sub(1), (k + 1).min(rows - 1));
             for i in 0..n {
-                let around = at(k, (i + 1) % n) - at(k, (i + n - 1) % n);
+                // The neighbours round the ring (compared, not taken modulo n: a division per
+                // point costs more than the rest of the normal).
+                let (before, after) = (
+                    if i == 0 { n - 1 } else { i - 1 },
+                    if i + 1 == n { 0 } else { i + 1 },
+                );
+                let around = at(k, after) - at(k, before);
                 let up = at(ku, i) - at(kd, i);
                 // Contours run counter-clockwise seen from above: around × up points outward.
                 normals.push((outward * around.cross(up).normalize_or_zero()).to_array());
@@ -135,7 +141,7 @@ pub fn wall_buffers(
             let base = sheet * rows * n;
             let (r0, r1) = ((base + k * n) as u32, (base + (k + 1) * n) as u32);
             for i in 0..n as u32 {
-                let j = (i + 1) % n as u32;
+                let j = if i + 1 == n as u32 { 0 } else { i + 1 };
                 if sheet == 0 {
                     b.indices
                         .extend_from_slice(&[r0 + i, r0 + j, r1 + j, r0 + i, r1 + j, r1 + i]);
