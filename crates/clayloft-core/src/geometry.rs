@@ -13,30 +13,34 @@ pub const POINT_EPS: f64 = 1e-6;
 /// Signed area of a closed polyline by the shoelace formula, `A = ½ Σ (xᵢ yᵢ₊₁ − xᵢ₊₁ yᵢ)`.
 /// Positive for counter-clockwise order.
 pub fn signed_area(points: &[DVec2]) -> f64 {
-    let n = points.len();
-    (0..n)
-        .map(|i| points[i].perp_dot(points[(i + 1) % n]))
+    segments_closed(points)
+        .map(|(a, b)| a.perp_dot(b))
         .sum::<f64>()
         * 0.5
 }
 
+/// The segments of a closed polyline in order, the closing one last (neighbours by an iterator,
+/// not by index modulo n: a division per vertex costs more than the work on it).
+fn segments_closed(points: &[DVec2]) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
+    points
+        .iter()
+        .copied()
+        .zip(points.iter().skip(1).chain(points.first()).copied())
+}
+
 /// Total length of a closed polyline (including the closing segment).
 pub fn closed_length(points: &[DVec2]) -> f64 {
-    let n = points.len();
-    (0..n)
-        .map(|i| points[i].distance(points[(i + 1) % n]))
-        .sum()
+    segments_closed(points).map(|(a, b)| a.distance(b)).sum()
 }
 
 /// Cumulative arc length at each vertex of a closed polyline: `s[0] = 0`, `s[i] = Σ_{j<i} |p_{j+1} − p_j|`.
 /// The returned vector has `n + 1` entries; the last one is the closed length.
 pub fn cumulative_length(points: &[DVec2]) -> Vec<f64> {
-    let n = points.len();
-    let mut s = Vec::with_capacity(n + 1);
+    let mut s = Vec::with_capacity(points.len() + 1);
     let mut acc = 0.0;
     s.push(0.0);
-    for i in 0..n {
-        acc += points[i].distance(points[(i + 1) % n]);
+    for (a, b) in segments_closed(points) {
+        acc += a.distance(b);
         s.push(acc);
     }
     s
@@ -184,8 +188,15 @@ pub fn without_loops(points: &[DVec2]) -> Vec<DVec2> {
 /// Outward unit normal in XY at each vertex of a counter-clockwise closed polyline, from the
 /// central difference `pᵢ₊₁ − pᵢ₋₁` rotated by −90°.
 pub fn outward_normals(points: &[DVec2]) -> Vec<DVec2> {
-    (0..points.len())
-        .map(|i| outward_normal_at(points, i))
+    let n = points.len();
+    (0..n)
+        .map(|i| {
+            // [`outward_normal_at`], the neighbours compared rather than taken modulo n.
+            let before = points[if i == 0 { n - 1 } else { i - 1 }];
+            let after = points[if i + 1 == n { 0 } else { i + 1 }];
+            let d = after - before;
+            DVec2::new(d.y, -d.x).normalize_or_zero()
+        })
         .collect()
 }
 

@@ -43,7 +43,7 @@ impl Section {
 mod tests {
     use super::*;
 
-    /// The same normals, to the bit, as the XY copy's (one, two and many points).
+    /// The same normals, to the bit, as each XY point's alone (one, two and many points).
     #[test]
     fn normals_are_those_of_the_xy_outline() {
         for n in [1usize, 2, 3, 7, 360] {
@@ -60,11 +60,16 @@ mod tests {
                 .iter()
                 .map(|v| v.to_array().map(f64::to_bits))
                 .collect();
-            let xy: Vec<[u64; 2]> = crate::geometry::outward_normals(&s.xy())
+            let xy: Vec<[u64; 2]> = (0..n)
+                .map(|i| crate::geometry::outward_normal_at(&s.xy(), i))
+                .map(|v| v.to_array().map(f64::to_bits))
+                .collect();
+            let outline: Vec<[u64; 2]> = crate::geometry::outward_normals(&s.xy())
                 .iter()
                 .map(|v| v.to_array().map(f64::to_bits))
                 .collect();
             assert_eq!(ours, xy, "{n} points");
+            assert_eq!(outline, xy, "{n} points");
         }
     }
 }

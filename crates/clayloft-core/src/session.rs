@@ -26,7 +26,6 @@ use std::sync::Arc;
 
 use glam::DVec2;
 
-use crate::control::VerticalProfile;
 use crate::design::{BedShape, ContourSpec, Design, HorizontalLine, Origin, Texture, VerticalLine};
 use crate::loft::{LoftInput, SampledContour, sample_contour};
 use crate::pipeline::{PrintJob, Surface, finish_sections};
@@ -361,12 +360,7 @@ impl Session {
         let Some((model, plan_findings)) = self.plan.value.as_mut() else {
             unreachable!("the plan stage ran above")
         };
-        model.vertical = design
-            .control
-            .vertical
-            .iter()
-            .map(VerticalProfile::new)
-            .collect();
+        model.set_vertical(&design.control.vertical);
         let model = &*model;
 
         // 3. Sections, each keyed by the lines active at its height; the dirty ones in parallel.
@@ -382,7 +376,7 @@ impl Session {
                 .control
                 .vertical
                 .iter()
-                .zip(&model.vertical)
+                .zip(model.vertical())
                 .filter(|(_, profile)| profile.offset_at(t) != 0.0)
                 .map(|(line, _)| line.clone())
                 .collect();

@@ -10,7 +10,7 @@ use glam::{DVec2, DVec3};
 
 use crate::control::angle_difference;
 use crate::control::{HorizontalProfile, VerticalProfile};
-use crate::design::Design;
+use crate::design::{Design, VerticalLine};
 use crate::geometry::{outward_normal_at, outward_normals};
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind};
@@ -27,7 +27,11 @@ const PLAN_STEPS: usize = 512;
 #[derive(Debug, Clone)]
 pub struct ShapeModel {
     pub loft: LoftInput,
-    pub vertical: Vec<VerticalProfile>,
+    /// The vertical control lines ([`ShapeModel::set_vertical`]).
+    vertical: Vec<VerticalProfile>,
+    /// `weights[l][i]`: vertical line l's angular weight at sample i (they do not change with
+    /// the height, so every section reads them instead of a cosine per point).
+    weights: Vec<Vec<f64>>,
     pub horizontal: Vec<HorizontalProfile>,
     /// `hz[l][i]`: full-weight z offset of horizontal line l at sample i.
     pub hz: Vec<Vec<f64>>,
@@ -44,12 +48,6 @@ impl ShapeModel {
     /// Builds the model and plans the layers; returns findings for any horizontal-line scaling.
     /// A plan with more than [`MAX_PATH_POINTS`] wall points is an error on `shape.samples`.
     pub fn new(design: &Design, loft: LoftInput) -> Result<(ShapeModel, Vec<Finding>), FieldError> {
-        let vertical: Vec<_> = design
-            .control
-            .vertical
-            .iter()
-            .map(VerticalProfile::new)
-            .collect();
         let horizontal: Vec<_> = design
             .control
             .horizontal
@@ -62,7 +60,8 @@ impl ShapeModel {
             .collect();
         let mut model = ShapeModel {
             loft,
-            vertical,
+            vertical: Vec::new(),
+            weights: Vec::new(),
             horizontal,
             hz,
             hz_scale: 1.0,
@@ -70,6 +69,7 @@ impl ShapeModel {
             layer_pitch: design.shape.height,
             height: design.shape.height,
         };
+        model.set_vertical(&design.control.vertical);
         let findings = model.plan_layers(design);
         let points = (model.layers as u128 + 1) * model.loft.samples() as u128;
         if points > MAX_PATH_POINTS as u128 {
@@ -96,6 +96,28 @@ impl ShapeModel {
             }
         }
         dz * self.hz_scale
+    }
+
+    /// Puts in the vertical control lines (the layer plan does not read them, so a session
+    /// changes them on a kept plan).
+    pub fn set_vertical(&mut self, lines: &[VerticalLine]) {
+        self.vertical = lines.iter().map(VerticalProfile::new).collect();
+        self.weights = self
+            .vertical
+            .iter()
+            .map(|v| {
+                self.loft
+                    .angles
+                    .iter()
+                    .map(|&phi| v.weight_at(phi))
+                    .collect()
+            })
+            .collect();
+    }
+
+    /// The vertical control lines, in the design's order.
+    pub fn vertical(&self) -> &[VerticalProfile] {
+        &self.vertical
     }
 
     /// The shaped section k: loft, vertical control offsets along the normal, z with horizontal
@@ -127,8 +149,8 @@ impl ShapeModel {
         let points = (0..n)
             .map(|i| {
                 let mut p = xy[i];
-                for (v, d) in &active {
-                    p += normals[i] * (d * v.weight_at(self.loft.angles[i]));
+                for (l, d) in &active {
+                    p += normals[i] * (d * self.weights[*l][i]);
                 }
                 let z = z0.map_or(0.0, |z0| z0 + self.dz(i, t));
                 DVec3::new(p.x, p.y, z)
@@ -137,13 +159,14 @@ impl ShapeModel {
         Section { points }
     }
 
-    /// The vertical lines with a non-zero offset at t and that offset, leaving out `skip`.
-    fn active_vertical(&self, t: f64, skip: Option<usize>) -> Vec<(&VerticalProfile, f64)> {
+    /// The vertical lines (by index) with a non-zero offset at t and that offset, leaving out
+    /// `skip`.
+    fn active_vertical(&self, t: f64, skip: Option<usize>) -> Vec<(usize, f64)> {
         self.vertical
             .iter()
             .enumerate()
             .filter(|(l, _)| Some(*l) != skip)
-            .map(|(_, v)| (v, v.offset_at(t)))
+            .map(|(l, v)| (l, v.offset_at(t)))
             .filter(|(_, d)| *d != 0.0)
             .collect()
     }
@@ -182,15 +205,14 @@ impl ShapeModel {
             .map(|&j| self.loft.point(j, t))
             .collect();
         let normal = outward_normal_at(&xy, 1);
-        let phi = self.loft.angles[i];
         let mut base = xy[1];
-        for (v, d) in self.active_vertical(t, line) {
-            base += normal * (d * v.weight_at(phi));
+        for (l, d) in self.active_vertical(t, line) {
+            base += normal * (d * self.weights[l][i]);
         }
         let z = z0.map_or(0.0, |z0| z0 + self.dz(i, t));
         let dir = line
-            .and_then(|l| self.vertical.get(l))
-            .map_or(DVec2::ZERO, |v| normal * v.weight_at(phi));
+            .and_then(|l| self.weights.get(l))
+            .map_or(DVec2::ZERO, |w| normal * w[i]);
         (base.extend(z), dir)
     }
 
@@ -491,7 +513,7 @@ mod wall_tests {
         let t = 0.45;
         let i = m.column_at_angle(30f64.to_radians());
         let (base, dir) = m.wall_frame(i, t, Some(1));
-        let offset = m.vertical[1].offset_at(t);
+        let offset = m.vertical()[1].offset_at(t);
         assert!((offset - 4.0).abs() < 1e-12);
         let on_wall = m.wall_point(i, t);
         assert!((base.truncate() + dir * offset).distance(on_wall.truncate()) < 1e-9);

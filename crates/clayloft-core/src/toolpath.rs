@@ -302,7 +302,8 @@ pub fn build_toolpath_on(
             z_now[0] = below[0];
             for i in from..=n {
                 let f = (t as f64 + frac[i]) * share;
-                let j = i % n;
+                // i = n closes the turn at point 0 (compared: a division per point costs more).
+                let j = if i == n { 0 } else { i };
                 let (z, g) = if k == first {
                     // Leave the flat layer by at least the minimum layer height; XY follows the z
                     // progress so the lean never exceeds that of the sections.
