@@ -751,13 +751,16 @@ fn put_digits(buf: &mut Vec<u8>, mut n: u64, min_digits: usize) {
 #[inline]
 pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
     let pow = 10u64.pow(decimals);
-    let scaled = (v.abs() * pow as f64).round();
-    if !scaled.is_finite() || scaled >= 9.0e18 {
+    let x = v.abs() * pow as f64;
+    if !x.is_finite() || x >= 9.0e18 {
         // Out of range for integer formatting (never for a real printer); fall back.
         buf.extend_from_slice(format!("{v:.*}", decimals as usize).as_bytes());
         return;
     }
-    let n = scaled as u64;
+    // `x.round()` (half away from zero) without the library call the baseline x86-64 target
+    // makes of it: below 2⁵³ the fraction `x − ⌊x⌋` is exact, above it x is whole.
+    let whole = x as u64;
+    let n = whole + u64::from(x - whole as f64 >= 0.5);
     if v < 0.0 && n != 0 {
         buf.push(b'-');
     }
@@ -776,6 +779,37 @@ mod tests {
         let mut b = Vec::new();
         put_fixed(&mut b, v, d);
         String::from_utf8(b).unwrap()
+    }
+
+    /// [`put_fixed`] as it was written with the library's `round`: the reference.
+    fn fixed_by_round(v: f64, decimals: u32) -> String {
+        let pow = 10u64.pow(decimals);
+        let scaled = (v.abs() * pow as f64).round();
+        if !scaled.is_finite() || scaled >= 9.0e18 {
+            return format!("{v:.*}", decimals as usize);
+        }
+        let n = scaled as u64;
+        let sign = if v < 0.0 && n != 0 { "-" } else { "" };
+        if decimals == 0 {
+            format!("{sign}{}", n / pow)
+        } else {
+            format!("{sign}{}.{:0w$}", n / pow, n % pow, w = decimals as usize)
+        }
+    }
+
+    proptest::proptest! {
+        /// The same text as with the library's rounding, on any number: halves, whole numbers,
+        /// values past 2⁵³ once scaled, the edge of the integer range, and the non-finite.
+        #[test]
+        fn fixed_point_rounds_as_the_library_does(
+            v in proptest::num::f64::ANY,
+            half in -1_000_000i64..1_000_000,
+            d in 0u32..7,
+        ) {
+            for x in [v, half as f64 + 0.5, (half as f64 + 0.5) / 10f64.powi(d as i32), half as f64, 9.0e18 / 10f64.powi(d as i32), 4_503_599_627_370_497.0] {
+                proptest::prop_assert_eq!(fixed(x, d), fixed_by_round(x, d), "{} with {} decimals", x, d);
+            }
+        }
     }
 
     /// The program's line index names, for every line that moves the nozzle along the path, the
