@@ -20,7 +20,7 @@ pub fn join<T>(handle: std::thread::ScopedJoinHandle<'_, T>) -> T {
 
 /// `0..len` cut into one contiguous range per core, or a single range when `len` is below
 /// `serial_below` (starting a thread costs more than small work).
-fn ranges(len: usize, serial_below: usize) -> Vec<Range<usize>> {
+pub fn ranges(len: usize, serial_below: usize) -> Vec<Range<usize>> {
     let threads = cores().min(len.max(1));
     if threads < 2 || len < serial_below {
         return std::iter::once(0..len).collect();
