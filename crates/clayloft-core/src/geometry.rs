@@ -188,23 +188,33 @@ pub fn without_loops(points: &[DVec2]) -> Vec<DVec2> {
 /// Outward unit normal in XY at each vertex of a counter-clockwise closed polyline, from the
 /// central difference `pᵢ₊₁ − pᵢ₋₁` rotated by −90°.
 pub fn outward_normals(points: &[DVec2]) -> Vec<DVec2> {
-    let n = points.len();
-    (0..n)
-        .map(|i| {
-            // [`outward_normal_at`], the neighbours compared rather than taken modulo n.
-            let before = points[if i == 0 { n - 1 } else { i - 1 }];
-            let after = points[if i + 1 == n { 0 } else { i + 1 }];
-            let d = after - before;
-            DVec2::new(d.y, -d.x).normalize_or_zero()
-        })
+    (0..points.len())
+        .map(|i| outward_normal_at(points, i))
         .collect()
 }
 
 /// The outward unit normal of [`outward_normals`] at vertex i alone.
 #[inline]
 pub fn outward_normal_at(points: &[DVec2], i: usize) -> DVec2 {
-    let n = points.len();
-    let d = points[(i + 1) % n] - points[(i + n - 1) % n];
+    let (before, after) = ring_neighbours(i, points.len());
+    normal_from_neighbours(points[before], points[after])
+}
+
+/// The vertices before and after vertex i of a closed ring of `n` (compared, not taken modulo
+/// n: a division per vertex costs more than the work done on it).
+#[inline]
+pub fn ring_neighbours(i: usize, n: usize) -> (usize, usize) {
+    (
+        if i == 0 { n - 1 } else { i - 1 },
+        if i + 1 == n { 0 } else { i + 1 },
+    )
+}
+
+/// The outward unit normal at a vertex of a counter-clockwise ring from its neighbours:
+/// `after − before` rotated by −90°, unit length (zero where they coincide).
+#[inline]
+pub fn normal_from_neighbours(before: DVec2, after: DVec2) -> DVec2 {
+    let d = after - before;
     DVec2::new(d.y, -d.x).normalize_or_zero()
 }
 

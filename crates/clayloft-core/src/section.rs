@@ -21,10 +21,8 @@ impl Section {
         let (p, n) = (&self.points, self.points.len());
         (0..n)
             .map(|i| {
-                let before = p[if i == 0 { n - 1 } else { i - 1 }];
-                let after = p[if i + 1 == n { 0 } else { i + 1 }];
-                let d = after.truncate() - before.truncate();
-                DVec2::new(d.y, -d.x).normalize_or_zero()
+                let (before, after) = crate::geometry::ring_neighbours(i, n);
+                crate::geometry::normal_from_neighbours(p[before].truncate(), p[after].truncate())
             })
             .collect()
     }

@@ -150,6 +150,29 @@ pub fn apply_displacements(
     events
 }
 
+/// The largest share (0 … 1) of the texture a column may take at the point `above` over `below`
+/// (their untextured normals, their displacements) without leaning past `tan_limit`: the
+/// textured offset `b + s·(d n·n_below − d_below)` along the normal below stays within
+/// `Δz·tan_limit`.
+fn admissible_scale(
+    (above, below): (glam::DVec3, glam::DVec3),
+    (normal, normal_below): (glam::DVec2, glam::DVec2),
+    (d, d_below): (f64, f64),
+    tan_limit: f64,
+) -> f64 {
+    let b = (above.truncate() - below.truncate()).dot(normal_below);
+    let dd = d * normal.dot(normal_below) - d_below;
+    let limit = (above.z - below.z).max(0.0) * tan_limit;
+    let allowed = if dd > 1e-12 {
+        (limit - b) / dd
+    } else if dd < -1e-12 {
+        (limit + b) / -dd
+    } else {
+        1.0
+    };
+    allowed.clamp(0.0, 1.0)
+}
+
 /// [`apply_displacements`] on the columns `cols` (`part[k]`: section k's points there; `left`,
 /// `right`: each section's point just before and after them): the normals before the texture,
 /// the largest admissible scale of each column and the layer where it binds, the shifts; the
@@ -178,8 +201,7 @@ fn texture_columns(
             } else {
                 row[c + 1].truncate()
             };
-            let d = after - before;
-            normals.push(glam::DVec2::new(d.y, -d.x).normalize_or_zero());
+            normals.push(crate::geometry::normal_from_neighbours(before, after));
         }
     }
     // Largest admissible scale per column, and the layer where it binds.
@@ -187,19 +209,12 @@ fn texture_columns(
     for k in 1..count {
         let (above, below) = (&part[k], &part[k - 1]);
         for (c, i) in cols.clone().enumerate() {
-            let (p, q) = (above[c], below[c]);
-            let nb = normals[(k - 1) * w + c];
-            let b = (p.truncate() - q.truncate()).dot(nb);
-            let dd = disp[k][i] * normals[k * w + c].dot(nb) - disp[k - 1][i];
-            let limit = (p.z - q.z).max(0.0) * tan_limit;
-            let allowed = if dd > 1e-12 {
-                (limit - b) / dd
-            } else if dd < -1e-12 {
-                (limit + b) / -dd
-            } else {
-                1.0
-            };
-            let allowed = allowed.clamp(0.0, 1.0);
+            let allowed = admissible_scale(
+                (above[c], below[c]),
+                (normals[k * w + c], normals[(k - 1) * w + c]),
+                (disp[k][i], disp[k - 1][i]),
+                tan_limit,
+            );
             if allowed < scale[c].0 {
                 scale[c] = (allowed, k);
             }
@@ -244,19 +259,12 @@ mod tests {
         let mut scale = vec![(1.0_f64, 0_usize); n];
         for k in 1..sections.len() {
             for i in 0..n {
-                let (p, q) = (sections[k].points[i], sections[k - 1].points[i]);
-                let nb = normals[k - 1][i];
-                let b = (p.truncate() - q.truncate()).dot(nb);
-                let dd = disp[k][i] * normals[k][i].dot(nb) - disp[k - 1][i];
-                let limit = (p.z - q.z).max(0.0) * tan_limit;
-                let allowed = if dd > 1e-12 {
-                    (limit - b) / dd
-                } else if dd < -1e-12 {
-                    (limit + b) / -dd
-                } else {
-                    1.0
-                };
-                let allowed = allowed.clamp(0.0, 1.0);
+                let allowed = admissible_scale(
+                    (sections[k].points[i], sections[k - 1].points[i]),
+                    (normals[k][i], normals[k - 1][i]),
+                    (disp[k][i], disp[k - 1][i]),
+                    tan_limit,
+                );
                 if allowed < scale[i].0 {
                     scale[i] = (allowed, k);
                 }

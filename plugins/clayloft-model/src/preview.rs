@@ -120,12 +120,7 @@ pub fn wall_buffers(
         for k in 0..rows {
             let (kd, ku) = (k.saturating_sub(1), (k + 1).min(rows - 1));
             for i in 0..n {
-                // The neighbours round the ring (compared, not taken modulo n: a division per
-                // point costs more than the rest of the normal).
-                let (before, after) = (
-                    if i == 0 { n - 1 } else { i - 1 },
-                    if i + 1 == n { 0 } else { i + 1 },
-                );
+                let (before, after) = clayloft_core::geometry::ring_neighbours(i, n);
                 let around = at(k, after) - at(k, before);
                 let up = at(ku, i) - at(kd, i);
                 // Contours run counter-clockwise seen from above: around × up points outward.
