@@ -188,6 +188,15 @@ fn gcode_writing(c: &mut Criterion) {
         })
     });
     g.finish();
+    // The header's figures of the benchmark vessel: the motion planner (look-ahead, corners,
+    // trapezoids over its 220 706 moves), the clay volume and the path length.
+    let design = parse_design(BIG_DESIGN).unwrap();
+    let job = clayloft_core::run(&design).unwrap();
+    let mut g = c.benchmark_group("gcode");
+    g.bench_function("summary_720x300", |b| {
+        b.iter(|| black_box(clayloft_core::gcode::summarize(&design, &job)))
+    });
+    g.finish();
 }
 
 /// A closed vessel of revolution 300 mm tall with `n` points round and `rings` rings: 2·n·rings

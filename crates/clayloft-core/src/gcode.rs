@@ -11,6 +11,8 @@ use std::io::{self, Write};
 
 use glam::DVec3;
 
+use crate::decimal::Line;
+pub use crate::decimal::put_fixed;
 use crate::design::{BedShape, Design, Dialect, ExtrusionMode, Kinematics, Origin};
 use crate::motion;
 use crate::pipeline::PrintJob;
@@ -68,35 +70,57 @@ fn home_position(p: &crate::design::Printer) -> DVec3 {
 
 /// The moves of the whole job as the motion planner sees them, from the home position: the
 /// approach (up, over, down), the path, the exit lift.
-fn planned_moves<'a>(
-    design: &Design,
-    tp: &'a Toolpath,
-) -> (DVec3, impl Iterator<Item = motion::Move> + 'a) {
-    let p = &design.printer;
-    let (z_in, z_out) = clearance_heights(design, tp);
-    let home = home_position(p);
-    let travel = p.travel_speed;
-    let at = |to: DVec3| motion::Move { to, speed: travel };
-    let (approach, exit) = match (tp.points.first(), tp.points.last()) {
-        (Some(f), Some(l)) => (
-            vec![
-                at(DVec3::new(home.x, home.y, z_in)),
-                at(DVec3::new(f.pos.x, f.pos.y, z_in)),
-                at(f.pos),
-            ],
-            Some(at(DVec3::new(l.pos.x, l.pos.y, z_out))),
-        ),
-        _ => (Vec::new(), None),
-    };
-    let path = tp.points.get(1..).unwrap_or(&[]);
-    let moves = approach
-        .into_iter()
-        .chain(path.iter().map(|q| motion::Move {
-            to: q.pos,
-            speed: q.speed,
-        }))
-        .chain(exit);
-    (home, moves)
+struct JobMoves<'a> {
+    home: DVec3,
+    approach: Vec<motion::Move>,
+    path: &'a [crate::toolpath::PathPoint],
+    exit: Option<motion::Move>,
+}
+
+impl<'a> JobMoves<'a> {
+    fn new(design: &Design, tp: &'a Toolpath) -> Self {
+        let p = &design.printer;
+        let (z_in, z_out) = clearance_heights(design, tp);
+        let home = home_position(p);
+        let travel = p.travel_speed;
+        let at = |to: DVec3| motion::Move { to, speed: travel };
+        let (approach, exit) = match (tp.points.first(), tp.points.last()) {
+            (Some(f), Some(l)) => (
+                vec![
+                    at(DVec3::new(home.x, home.y, z_in)),
+                    at(DVec3::new(f.pos.x, f.pos.y, z_in)),
+                    at(f.pos),
+                ],
+                Some(at(DVec3::new(l.pos.x, l.pos.y, z_out))),
+            ),
+            _ => (Vec::new(), None),
+        };
+        Self {
+            home,
+            approach,
+            path: tp.points.get(1..).unwrap_or(&[]),
+            exit,
+        }
+    }
+}
+
+impl motion::Moves for JobMoves<'_> {
+    fn len(&self) -> usize {
+        self.approach.len() + self.path.len() + usize::from(self.exit.is_some())
+    }
+
+    fn get(&self, i: usize) -> motion::Move {
+        let Some(k) = i.checked_sub(self.approach.len()) else {
+            return self.approach[i];
+        };
+        match self.path.get(k) {
+            Some(q) => motion::Move {
+                to: q.pos,
+                speed: q.speed,
+            },
+            None => self.exit.expect("an index below len()"),
+        }
+    }
 }
 
 /// Length, time and volume of a job.
@@ -106,15 +130,15 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
     let volume: f64 = (1..tp.points.len())
         .map(|i| segment_volume(design, tp, i))
         .sum();
-    let (home, moves) = planned_moves(design, tp);
+    let moves = JobMoves::new(design, tp);
     let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
     JobSummary {
         layers: job.surface.layers,
         points: tp.points.len(),
         path_length_mm: tp.length(),
         estimated_time_s: motion::plan_time_of(
-            home,
-            moves,
+            moves.home,
+            &moves,
             p.max_acceleration,
             p.junction_deviation,
         ),
@@ -648,6 +672,7 @@ impl<'a> BodyWriter<'a> {
         let [ox, oy] = self.origin;
         let mut buf: Vec<u8> = Vec::with_capacity(range.len() * 48);
         let mut lines: Vec<u32> = Vec::new();
+        let mut line = Line::new();
         let mark = |lines: &mut Vec<u32>, count: usize, point: usize| {
             if want_index {
                 lines.extend(std::iter::repeat_n(point as u32, count));
@@ -691,83 +716,30 @@ impl<'a> BodyWriter<'a> {
             let prev = &tp.points[i - 1];
             st.t_done += prev.pos.distance(q.pos) / q.speed;
             let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
-            buf.extend_from_slice(b"G1 X");
-            put_fixed(&mut buf, q.pos.x - ox, 3);
-            buf.extend_from_slice(b" Y");
-            put_fixed(&mut buf, q.pos.y - oy, 3);
-            buf.extend_from_slice(b" Z");
-            put_fixed(&mut buf, q.pos.z, 3);
-            buf.extend_from_slice(b" E");
+            line.clear();
+            line.text(b"G1 X")
+                .fixed(q.pos.x - ox, 3)
+                .text(b" Y")
+                .fixed(q.pos.y - oy, 3)
+                .text(b" Z")
+                .fixed(q.pos.z, 3)
+                .text(b" E");
             match p.extrusion {
-                ExtrusionMode::Relative => put_fixed(&mut buf, e, 5),
+                ExtrusionMode::Relative => line.fixed(e, 5),
                 ExtrusionMode::Absolute => {
                     st.e_total += e;
-                    put_fixed(&mut buf, st.e_total, 5)
+                    line.fixed(st.e_total, 5)
                 }
-            }
+            };
             if q.speed != st.last_speed {
-                buf.extend_from_slice(b" F");
-                put_fixed(&mut buf, q.speed * 60.0, 1);
+                line.text(b" F").fixed(q.speed * 60.0, 1);
                 st.last_speed = q.speed;
             }
-            buf.push(b'\n');
+            line.text(b"\n");
+            buf.extend_from_slice(line.as_bytes());
             mark(&mut lines, 1, i);
         }
         (buf, lines)
-    }
-}
-
-/// Two-digit pairs "00" … "99", for writing integers two digits per division.
-const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
-2021222324252627282930313233343536373839\
-4041424344454647484950515253545556575859\
-6061626364656667686970717273747576777879\
-8081828384858687888990919293949596979899";
-
-/// Appends the decimal digits of `n`, at least `min_digits` of them (zero-padded).
-#[inline]
-fn put_digits(buf: &mut Vec<u8>, mut n: u64, min_digits: usize) {
-    let mut tmp = [b'0'; 24];
-    let mut pos = tmp.len();
-    while n >= 100 {
-        let pair = (n % 100) as usize * 2;
-        n /= 100;
-        pos -= 2;
-        tmp[pos..pos + 2].copy_from_slice(&DIGIT_PAIRS[pair..pair + 2]);
-    }
-    if n >= 10 {
-        pos -= 2;
-        tmp[pos..pos + 2].copy_from_slice(&DIGIT_PAIRS[n as usize * 2..n as usize * 2 + 2]);
-    } else {
-        pos -= 1;
-        tmp[pos] = b'0' + n as u8;
-    }
-    let start = pos.min(tmp.len() - min_digits.min(tmp.len()));
-    buf.extend_from_slice(&tmp[start..]);
-}
-
-/// Appends `v` with exactly `decimals` digits after the point (none and no point for 0),
-/// rounded half away from zero; `-0` is written as `0`.
-#[inline]
-pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
-    let pow = 10u64.pow(decimals);
-    let x = v.abs() * pow as f64;
-    if !x.is_finite() || x >= 9.0e18 {
-        // Out of range for integer formatting (never for a real printer); fall back.
-        buf.extend_from_slice(format!("{v:.*}", decimals as usize).as_bytes());
-        return;
-    }
-    // `x.round()` (half away from zero) without the library call the baseline x86-64 target
-    // makes of it: below 2⁵³ the fraction `x − ⌊x⌋` is exact, above it x is whole.
-    let whole = x as u64;
-    let n = whole + u64::from(x - whole as f64 >= 0.5);
-    if v < 0.0 && n != 0 {
-        buf.push(b'-');
-    }
-    put_digits(buf, n / pow, 1);
-    if decimals > 0 {
-        buf.push(b'.');
-        put_digits(buf, n % pow, decimals as usize);
     }
 }
 
@@ -779,37 +751,6 @@ mod tests {
         let mut b = Vec::new();
         put_fixed(&mut b, v, d);
         String::from_utf8(b).unwrap()
-    }
-
-    /// [`put_fixed`] as it was written with the library's `round`: the reference.
-    fn fixed_by_round(v: f64, decimals: u32) -> String {
-        let pow = 10u64.pow(decimals);
-        let scaled = (v.abs() * pow as f64).round();
-        if !scaled.is_finite() || scaled >= 9.0e18 {
-            return format!("{v:.*}", decimals as usize);
-        }
-        let n = scaled as u64;
-        let sign = if v < 0.0 && n != 0 { "-" } else { "" };
-        if decimals == 0 {
-            format!("{sign}{}", n / pow)
-        } else {
-            format!("{sign}{}.{:0w$}", n / pow, n % pow, w = decimals as usize)
-        }
-    }
-
-    proptest::proptest! {
-        /// The same text as with the library's rounding, on any number: halves, whole numbers,
-        /// values past 2⁵³ once scaled, the edge of the integer range, and the non-finite.
-        #[test]
-        fn fixed_point_rounds_as_the_library_does(
-            v in proptest::num::f64::ANY,
-            half in -1_000_000i64..1_000_000,
-            d in 0u32..7,
-        ) {
-            for x in [v, half as f64 + 0.5, (half as f64 + 0.5) / 10f64.powi(d as i32), half as f64, 9.0e18 / 10f64.powi(d as i32), 4_503_599_627_370_497.0] {
-                proptest::prop_assert_eq!(fixed(x, d), fixed_by_round(x, d), "{} with {} decimals", x, d);
-            }
-        }
     }
 
     /// The program's line index names, for every line that moves the nozzle along the path, the

@@ -27,6 +27,7 @@ pub mod clay;
 pub mod constraint;
 pub mod contour;
 pub mod control;
+pub mod decimal;
 pub mod design;
 pub mod fields;
 pub mod gcode;

@@ -49,37 +49,149 @@ pub fn junction_speed(u: DVec3, w: DVec3, a: f64, deviation: f64) -> f64 {
     junction_speed2(u, w, a, deviation, f64::INFINITY).sqrt()
 }
 
+/// A job's moves by index: the planner reads them in parts, one per core.
+pub trait Moves: Sync {
+    fn len(&self) -> usize;
+    fn get(&self, i: usize) -> Move;
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl Moves for [Move] {
+    fn len(&self) -> usize {
+        <[Move]>::len(self)
+    }
+    fn get(&self, i: usize) -> Move {
+        self[i]
+    }
+}
+
+/// Moves below which the planner stays on one core (starting a thread costs more).
+const SERIAL_BELOW: usize = 20_000;
+
 /// Total time of `moves` starting at rest at `start` and ending at rest, s.
 ///
 /// Works on squared speeds (no square root where a limit does not bind: on a smooth spiral at
 /// constant speed almost every junction and every pass leaves the speed at its nominal value, and
-/// such moves take `len / v` directly).
+/// such moves take `len / v` directly). Each move's length and entry limit are found on every
+/// core; the two look-ahead passes, and the sum, in path order on one.
 pub fn plan_time(start: DVec3, moves: &[Move], a: f64, deviation: f64) -> f64 {
-    plan_time_of(start, moves.iter().copied(), a, deviation)
+    plan_time_of(start, moves, a, deviation)
 }
 
-/// [`plan_time`] of moves given one by one (no list of them is built).
-pub fn plan_time_of(
+/// [`plan_time`] of moves read by index (no list of them is built).
+pub fn plan_time_of(start: DVec3, moves: &(impl Moves + ?Sized), a: f64, deviation: f64) -> f64 {
+    plan_time_in(start, moves, a, deviation, SERIAL_BELOW)
+}
+
+/// [`plan_time`], on one core below `serial_below` moves.
+fn plan_time_in(
     start: DVec3,
-    moves: impl IntoIterator<Item = Move>,
+    moves: &(impl Moves + ?Sized),
     a: f64,
     deviation: f64,
+    serial_below: usize,
 ) -> f64 {
     if a.is_nan() || a <= 0.0 {
         return 0.0;
     }
-    let moves = moves.into_iter();
-    let hint = moves.size_hint().0;
+    let n = moves.len();
     let two_a = 2.0 * a;
-    let mut len = Vec::with_capacity(hint);
-    let mut speed = Vec::with_capacity(hint);
+    let (mut len, mut speed) = (vec![0.0; n], vec![0.0; n]);
     // entry2[i]: squared speed entering move i; entry2[n] = 0 (the job ends at rest).
-    let mut entry2 = Vec::with_capacity(hint + 1);
-    let mut prev = start;
-    let mut last_dir: Option<DVec3> = None;
-    let mut last_speed2 = 0.0;
+    let mut entry2 = vec![0.0; n + 1];
+    let parts = crate::parallel::ranges(n, serial_below);
+    std::thread::scope(|scope| {
+        let (mut len, mut speed, mut entry2) = (&mut len[..], &mut speed[..], &mut entry2[..n]);
+        let mut handles = Vec::new();
+        for (k, range) in parts.iter().enumerate() {
+            let (l, rest_l) = std::mem::take(&mut len).split_at_mut(range.len());
+            let (s, rest_s) = std::mem::take(&mut speed).split_at_mut(range.len());
+            let (e, rest_e) = std::mem::take(&mut entry2).split_at_mut(range.len());
+            (len, speed, entry2) = (rest_l, rest_s, rest_e);
+            let legs = Legs {
+                len: l,
+                speed: s,
+                entry2: e,
+            };
+            let range = range.clone();
+            if k + 1 == parts.len() {
+                // The last part on the calling thread: one thread fewer to start.
+                entry_limits(start, moves, range, legs, a, deviation);
+            } else {
+                handles.push(
+                    scope.spawn(move || entry_limits(start, moves, range, legs, a, deviation)),
+                );
+            }
+        }
+        handles.into_iter().for_each(crate::parallel::join);
+    });
+    // Backward pass: every move can still slow down to the next entry speed.
+    for i in (0..n).rev() {
+        let reach = entry2[i + 1] + two_a * len[i];
+        if entry2[i] > reach {
+            entry2[i] = reach;
+        }
+    }
+    // Forward pass: acceleration from the previous entry limits this one. Once it has limited
+    // move i's exit (the next entry), both ends of move i are final: its time is added then.
+    let mut total = 0.0;
+    let (mut v_last, mut inv_v) = (f64::NAN, 0.0);
+    for i in 0..n {
+        let reach = entry2[i] + two_a * len[i];
+        if entry2[i + 1] > reach {
+            entry2[i + 1] = reach;
+        }
+        let v = speed[i];
+        if v != v_last {
+            (v_last, inv_v) = (v, 1.0 / v);
+        }
+        let v2 = v * v;
+        total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
+            len[i] * inv_v // cruising all the way
+        } else {
+            trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
+        };
+    }
+    total
+}
+
+/// One part of the planner's per-move values.
+struct Legs<'a> {
+    len: &'a mut [f64],
+    speed: &'a mut [f64],
+    entry2: &'a mut [f64],
+}
+
+/// Each move's length, speed and the squared speed it may enter at (its own speed, the speed
+/// before it and the corner allow), for moves `range`.
+fn entry_limits(
+    start: DVec3,
+    moves: &(impl Moves + ?Sized),
+    range: std::ops::Range<usize>,
+    legs: Legs,
+    a: f64,
+    deviation: f64,
+) {
+    let from = |i: usize| if i == 0 { start } else { moves.get(i - 1).to };
+    // What the moves before this part leave: the direction and squared speed of the last one
+    // that goes somewhere.
+    let (mut last_dir, mut last_speed2) = (None, 0.0);
+    for i in (0..range.start).rev() {
+        let m = moves.get(i);
+        let d = m.to - from(i);
+        let l = d.length();
+        if l != 0.0 {
+            last_dir = Some(d * (1.0 / l));
+            last_speed2 = m.speed * m.speed;
+            break;
+        }
+    }
+    let mut prev = from(range.start);
     let (mut cached_cap2, mut cached_threshold) = (f64::NAN, f64::INFINITY);
-    for m in moves {
+    for (k, i) in range.enumerate() {
+        let m = moves.get(i);
         let d = m.to - prev;
         let l = d.length();
         let v2 = m.speed * m.speed;
@@ -112,49 +224,18 @@ pub fn plan_time_of(
             last_dir = Some(w);
             j2
         };
-        entry2.push(limit2.min(v2).min(if l == 0.0 {
+        legs.entry2[k] = limit2.min(v2).min(if l == 0.0 {
             f64::INFINITY
         } else {
             last_speed2.max(v2)
-        }));
-        len.push(l);
-        speed.push(m.speed);
+        });
+        legs.len[k] = l;
+        legs.speed[k] = m.speed;
         prev = m.to;
         if l > 0.0 {
             last_speed2 = v2;
         }
     }
-    let n = len.len();
-    entry2.push(0.0);
-    // Backward pass: every move can still slow down to the next entry speed.
-    for i in (0..n).rev() {
-        let reach = entry2[i + 1] + two_a * len[i];
-        if entry2[i] > reach {
-            entry2[i] = reach;
-        }
-    }
-    // Forward pass: acceleration from the previous entry limits this one.
-    for i in 0..n {
-        let reach = entry2[i] + two_a * len[i];
-        if entry2[i + 1] > reach {
-            entry2[i + 1] = reach;
-        }
-    }
-    let mut total = 0.0;
-    let (mut v_last, mut inv_v) = (f64::NAN, 0.0);
-    for i in 0..n {
-        let v = speed[i];
-        if v != v_last {
-            (v_last, inv_v) = (v, 1.0 / v);
-        }
-        let v2 = v * v;
-        total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
-            len[i] * inv_v // cruising all the way
-        } else {
-            trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
-        };
-    }
-    total
 }
 
 /// The `sin²(θ/2)` above which a junction's speed limit reaches `cap2`: `v² = a·δ·s/(1 − s)`
@@ -185,6 +266,133 @@ fn junction_speed2(u: DVec3, w: DVec3, a: f64, deviation: f64, cap2: f64) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The planner as it was written before it ran in parts, in one pass over an iterator: the
+    /// reference the parts must match to the bit.
+    fn plan_time_reference(
+        start: DVec3,
+        moves: impl IntoIterator<Item = Move>,
+        a: f64,
+        deviation: f64,
+    ) -> f64 {
+        if a.is_nan() || a <= 0.0 {
+            return 0.0;
+        }
+        let moves = moves.into_iter();
+        let hint = moves.size_hint().0;
+        let two_a = 2.0 * a;
+        let mut len = Vec::with_capacity(hint);
+        let mut speed = Vec::with_capacity(hint);
+        // entry2[i]: squared speed entering move i; entry2[n] = 0 (the job ends at rest).
+        let mut entry2 = Vec::with_capacity(hint + 1);
+        let mut prev = start;
+        let mut last_dir: Option<DVec3> = None;
+        let mut last_speed2 = 0.0;
+        let (mut cached_cap2, mut cached_threshold) = (f64::NAN, f64::INFINITY);
+        for m in moves {
+            let d = m.to - prev;
+            let l = d.length();
+            let v2 = m.speed * m.speed;
+            let limit2 = if l == 0.0 {
+                // A move that goes nowhere passes the speed on unchanged.
+                if last_dir.is_some() {
+                    f64::INFINITY
+                } else {
+                    0.0
+                }
+            } else {
+                let w = d * (1.0 / l);
+                let j2 = match last_dir {
+                    None => 0.0,
+                    Some(u) => {
+                        let cap2 = v2.min(last_speed2);
+                        if cap2 != cached_cap2 {
+                            cached_cap2 = cap2;
+                            cached_threshold = cap_threshold(cap2, a, deviation);
+                        }
+                        // Most junctions of a smooth path turn too little for the limit to bind.
+                        let sin_half2 = (1.0 + u.dot(w).clamp(-1.0, 1.0)) / 2.0;
+                        if sin_half2 >= cached_threshold {
+                            cap2
+                        } else {
+                            junction_speed2(u, w, a, deviation, cap2)
+                        }
+                    }
+                };
+                last_dir = Some(w);
+                j2
+            };
+            entry2.push(limit2.min(v2).min(if l == 0.0 {
+                f64::INFINITY
+            } else {
+                last_speed2.max(v2)
+            }));
+            len.push(l);
+            speed.push(m.speed);
+            prev = m.to;
+            if l > 0.0 {
+                last_speed2 = v2;
+            }
+        }
+        let n = len.len();
+        entry2.push(0.0);
+        // Backward pass: every move can still slow down to the next entry speed.
+        for i in (0..n).rev() {
+            let reach = entry2[i + 1] + two_a * len[i];
+            if entry2[i] > reach {
+                entry2[i] = reach;
+            }
+        }
+        // Forward pass: acceleration from the previous entry limits this one.
+        for i in 0..n {
+            let reach = entry2[i] + two_a * len[i];
+            if entry2[i + 1] > reach {
+                entry2[i + 1] = reach;
+            }
+        }
+        let mut total = 0.0;
+        let (mut v_last, mut inv_v) = (f64::NAN, 0.0);
+        for i in 0..n {
+            let v = speed[i];
+            if v != v_last {
+                (v_last, inv_v) = (v, 1.0 / v);
+            }
+            let v2 = v * v;
+            total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
+                len[i] * inv_v // cruising all the way
+            } else {
+                trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
+            };
+        }
+        total
+    }
+
+    proptest::proptest! {
+        /// In parts (as many as the points allow) the planner gives the one-pass planner's time
+        /// to the bit: corners from straight on to reversing, moves that go nowhere (first, in a
+        /// run, at a part's start), and speeds that change.
+        #[test]
+        fn parts_give_the_one_pass_time(
+            steps in proptest::collection::vec((0u8..6, -3.0f64..3.0, -3.0f64..3.0, 0.0f64..0.5, 1.0f64..80.0), 0..400),
+            serial_below in 1usize..50,
+            a in 50.0f64..5000.0,
+        ) {
+            let mut at = DVec3::ZERO;
+            let moves: Vec<Move> = steps
+                .iter()
+                .map(|&(kind, dx, dy, dz, speed)| {
+                    if kind > 1 {
+                        at += DVec3::new(dx, dy, dz);
+                    }
+                    Move { to: at, speed: if kind == 5 { 20.0 } else { speed } }
+                })
+                .collect();
+            let start = DVec3::new(1.0, 2.0, 0.0);
+            let parts = plan_time_in(start, &moves[..], a, 0.013, serial_below);
+            let reference = plan_time_reference(start, moves.iter().copied(), a, 0.013);
+            proptest::prop_assert_eq!(parts.to_bits(), reference.to_bits(), "{} vs {}", parts, reference);
+        }
+    }
 
     #[test]
     fn one_move_is_the_hand_computed_trapezoid() {

@@ -1,0 +1,199 @@
+//! Decimal text of G-code numbers: fixed-point, rounded half away from zero, written digit pair by
+//! digit pair into a line assembled on the stack.
+//!
+//! A path point's line is about 40 bytes and five numbers; writing it word by word into the
+//! output costs a capacity check and a copy call per word, and a division by a power of ten that
+//! the compiler only turns into a multiplication when the power is known. [`Line`] knows it (the
+//! decimals are a constant at every call) and is appended to the output in one copy.
+
+/// Two-digit pairs "00" … "99", for writing integers two digits per division.
+const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+2021222324252627282930313233343536373839\
+4041424344454647484950515253545556575859\
+6061626364656667686970717273747576777879\
+8081828384858687888990919293949596979899";
+
+/// Most decimals a number is written with (`10^MAX_DECIMALS` fits the fast path's integers).
+pub const MAX_DECIMALS: u32 = 6;
+
+/// One line of text assembled in a fixed buffer: numbers and words are written into it, then it
+/// is appended to the output in one copy. Room for any line of [`Line::CAPACITY`] bytes: five
+/// numbers of any `f64` at up to [`MAX_DECIMALS`] decimals (at most 317 characters each, for
+/// `-1.8e308`) and their words.
+pub struct Line {
+    bytes: [u8; Line::CAPACITY],
+    len: usize,
+}
+
+impl Default for Line {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Line {
+    pub const CAPACITY: usize = 2048;
+
+    pub fn new() -> Self {
+        Self {
+            bytes: [0; Self::CAPACITY],
+            len: 0,
+        }
+    }
+
+    /// Empties the line (the buffer is reused).
+    #[inline]
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// The text so far.
+    #[inline]
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.bytes[..self.len]
+    }
+
+    /// Appends `text` (panics past [`Line::CAPACITY`]: a line is a few words).
+    #[inline]
+    pub fn text(&mut self, text: &[u8]) -> &mut Self {
+        self.bytes[self.len..self.len + text.len()].copy_from_slice(text);
+        self.len += text.len();
+        self
+    }
+
+    /// Appends `v` with exactly `decimals` digits after the point (none and no point for 0),
+    /// rounded half away from zero; `-0` (and anything that rounds to it) is written `0`.
+    /// `decimals` is at most [`MAX_DECIMALS`].
+    #[inline]
+    pub fn fixed(&mut self, v: f64, decimals: u32) -> &mut Self {
+        match decimals {
+            0 => self.fixed_const::<0>(v),
+            1 => self.fixed_const::<1>(v),
+            2 => self.fixed_const::<2>(v),
+            3 => self.fixed_const::<3>(v),
+            4 => self.fixed_const::<4>(v),
+            5 => self.fixed_const::<5>(v),
+            6 => self.fixed_const::<6>(v),
+            _ => panic!("at most {MAX_DECIMALS} decimals, not {decimals}"),
+        }
+    }
+
+    /// [`Line::fixed`] with the decimals known to the compiler.
+    #[inline]
+    fn fixed_const<const D: u32>(&mut self, v: f64) -> &mut Self {
+        let pow = 10u64.pow(D);
+        let x = v.abs() * pow as f64;
+        // Out of range for integer formatting (never for a real printer), or not a number.
+        if !x.is_finite() || x >= 9.0e18 {
+            return self.text(format!("{v:.*}", D as usize).as_bytes());
+        }
+        // `x.round()` (half away from zero) without the library call the baseline x86-64 target
+        // makes of it: below 2⁵³ the fraction `x − ⌊x⌋` is exact, above it x is whole.
+        // Through i64 (x < 2⁶³): one conversion instruction each way.
+        let whole = x as i64;
+        let n = (whole + i64::from(x - whole as f64 >= 0.5)) as u64;
+        if v < 0.0 && n != 0 {
+            self.text(b"-");
+        }
+        let int = n / pow;
+        self.digits(int, int.checked_ilog10().map_or(1, |d| d as usize + 1));
+        if D > 0 {
+            self.text(b".");
+            self.digits(n % pow, D as usize);
+        }
+        self
+    }
+
+    /// Appends the last `width` decimal digits of `n` (zero-padded).
+    #[inline]
+    fn digits(&mut self, mut n: u64, width: usize) {
+        let out = &mut self.bytes[self.len..self.len + width];
+        let mut i = width;
+        while i >= 2 {
+            let pair = (n % 100) as usize * 2;
+            n /= 100;
+            i -= 2;
+            out[i] = DIGIT_PAIRS[pair];
+            out[i + 1] = DIGIT_PAIRS[pair + 1];
+        }
+        if i == 1 {
+            out[0] = b'0' + (n % 10) as u8;
+        }
+        self.len += width;
+    }
+}
+
+/// Appends `v` with exactly `decimals` digits after the point to `buf` (see [`Line::fixed`]).
+pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
+    let mut line = Line::new();
+    buf.extend_from_slice(line.fixed(v, decimals).as_bytes());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixed(v: f64, d: u32) -> String {
+        let mut b = Vec::new();
+        put_fixed(&mut b, v, d);
+        String::from_utf8(b).unwrap()
+    }
+
+    /// The text as the standard library's formatter writes it, rounded half away from zero with
+    /// the library's `round` (the formatter itself rounds half to even): the reference.
+    fn fixed_by_round(v: f64, decimals: u32) -> String {
+        let pow = 10u64.pow(decimals);
+        let scaled = (v.abs() * pow as f64).round();
+        if !scaled.is_finite() || scaled >= 9.0e18 {
+            return format!("{v:.*}", decimals as usize);
+        }
+        let n = scaled as u64;
+        let sign = if v < 0.0 && n != 0 { "-" } else { "" };
+        if decimals == 0 {
+            format!("{sign}{}", n / pow)
+        } else {
+            format!("{sign}{}.{:0w$}", n / pow, n % pow, w = decimals as usize)
+        }
+    }
+
+    proptest::proptest! {
+        /// The same text as with the library's rounding, on any number: halves, whole numbers,
+        /// values past 2⁵³ once scaled, the edge of the integer range, and the non-finite.
+        #[test]
+        fn fixed_point_rounds_as_the_library_does(
+            v in proptest::num::f64::ANY,
+            half in -1_000_000i64..1_000_000,
+            d in 0u32..=MAX_DECIMALS,
+        ) {
+            for x in [v, half as f64 + 0.5, (half as f64 + 0.5) / 10f64.powi(d as i32), half as f64, 9.0e18 / 10f64.powi(d as i32), 4_503_599_627_370_497.0] {
+                proptest::prop_assert_eq!(fixed(x, d), fixed_by_round(x, d), "{} with {} decimals", x, d);
+            }
+        }
+
+        /// A line of five numbers is the numbers' texts one after another, whatever they are.
+        #[test]
+        fn a_line_is_its_words_in_order(vs in proptest::collection::vec(proptest::num::f64::ANY, 5)) {
+            let mut line = Line::new();
+            let mut words = String::new();
+            for (k, &v) in vs.iter().enumerate() {
+                let d = [3, 3, 3, 5, 1][k];
+                line.text(b" W").fixed(v, d);
+                words.push_str(" W");
+                words.push_str(&fixed_by_round(v, d));
+            }
+            proptest::prop_assert_eq!(std::str::from_utf8(line.as_bytes()).unwrap(), words);
+        }
+    }
+
+    #[test]
+    fn the_longest_line_fits() {
+        let mut line = Line::new();
+        line.text(b"G1 X");
+        for d in [3, 3, 3, MAX_DECIMALS, MAX_DECIMALS] {
+            line.fixed(-f64::MAX, d).text(b" E");
+        }
+        assert!(line.as_bytes().len() <= Line::CAPACITY);
+        line.clear();
+        assert_eq!(line.fixed(-0.0, 3).as_bytes(), b"0.000");
+    }
+}
