@@ -95,6 +95,10 @@ fn pipeline(c: &mut Criterion) {
     g.bench_function("check_gcode_720x300", |b| {
         b.iter(|| black_box(clayloft_core::check::check_gcode(&text, &limits).unwrap()))
     });
+    // Of that, reading the file's moves.
+    g.bench_function("parse_gcode_720x300", |b| {
+        b.iter(|| black_box(clayloft_core::check::parse_moves(&text).unwrap()))
+    });
     g.finish();
 }
 

@@ -1,5 +1,5 @@
 //! Decimal text of G-code numbers: fixed-point, rounded half away from zero, written digit pair by
-//! digit pair into a line assembled on the stack.
+//! digit pair into a line assembled on the stack; and read back ([`parse_f64`]).
 //!
 //! A path point's line is about 40 bytes and five numbers; writing it word by word into the
 //! output costs a capacity check and a copy call per word, and a division by a power of ten that
@@ -123,6 +123,45 @@ impl Line {
     }
 }
 
+/// Powers of ten that are exact in double precision.
+const EXACT_POWERS: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// `text` as a number, exactly as `text.parse::<f64>()` reads it, reading the plain decimals a
+/// G-code file is made of (`-12.345`, `7`, `.5`) itself and leaving anything else to the
+/// standard library.
+///
+/// A plain decimal of m's digits with k after the point is m / 10^k. When m < 2⁵³ and k ≤ 22
+/// both are exact doubles, and one division rounds the quotient correctly (IEEE 754), as the
+/// standard parser does (Clinger's fast path): the same bits.
+pub fn parse_f64(text: &str) -> Result<f64, std::num::ParseFloatError> {
+    let bytes = text.as_bytes();
+    let (negative, digits) = match bytes.first() {
+        Some(b'-') => (true, &bytes[1..]),
+        Some(b'+') => (false, &bytes[1..]),
+        _ => (false, bytes),
+    };
+    let (mut m, mut count, mut after_point, mut point) = (0u64, 0usize, 0usize, false);
+    for &b in digits {
+        match b {
+            b'0'..=b'9' if count < 19 => {
+                m = m * 10 + u64::from(b - b'0');
+                count += 1;
+                after_point += usize::from(point);
+            }
+            b'.' if !point => point = true,
+            _ => return text.parse(),
+        }
+    }
+    if count == 0 || m >= 1 << 53 || after_point >= EXACT_POWERS.len() {
+        return text.parse();
+    }
+    let v = m as f64 / EXACT_POWERS[after_point];
+    Ok(if negative { -v } else { v })
+}
+
 /// Appends `v` with exactly `decimals` digits after the point to `buf` (see [`Line::fixed`]).
 pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
     let mut line = Line::new();
@@ -183,6 +222,36 @@ mod tests {
             }
             proptest::prop_assert_eq!(std::str::from_utf8(line.as_bytes()).unwrap(), words);
         }
+    }
+
+    proptest::proptest! {
+        /// The same number, or the same refusal, as the standard parser: plain decimals of any
+        /// length (past 19 digits and 2⁵³), signs, lone points, exponents and other text.
+        #[test]
+        fn numbers_read_as_the_standard_parser_reads_them(
+            text in "[+-]?[0-9]{0,24}(\\.[0-9]{0,24})?|[+-]?[0-9.eE+-]{0,12}|.{0,8}",
+            v in proptest::num::f64::ANY,
+            d in 0u32..=MAX_DECIMALS,
+        ) {
+            let written = fixed_by_round(v, d);
+            for t in [text.as_str(), written.as_str()] {
+                match (parse_f64(t), t.parse::<f64>()) {
+                    (Ok(a), Ok(b)) => proptest::prop_assert_eq!(a.to_bits(), b.to_bits(), "{:?}", t),
+                    (a, b) => proptest::prop_assert_eq!(a.is_ok(), b.is_ok(), "{:?}", t),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn plain_decimals_read_back() {
+        assert_eq!(parse_f64("-12.345"), Ok(-12.345));
+        assert_eq!(parse_f64(".5"), Ok(0.5));
+        assert_eq!(parse_f64("5."), Ok(5.0));
+        assert_eq!(parse_f64("-0").map(f64::to_bits), Ok((-0.0f64).to_bits()));
+        assert_eq!(parse_f64("9007199254740993"), Ok(9007199254740992.0));
+        assert_eq!(parse_f64("1e3"), Ok(1000.0));
+        assert!(parse_f64(".").is_err() && parse_f64("").is_err() && parse_f64("1.2.3").is_err());
     }
 
     #[test]

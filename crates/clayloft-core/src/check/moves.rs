@@ -24,14 +24,200 @@ pub struct Move {
 }
 
 /// Parses the moves of a G-code program (G0/G1 with G90/G91, M82/M83, G92, G20/G21).
+///
+/// Read in two steps: the lines are read in parts, one per core ([`read_part`]: the words and
+/// numbers of each line, which need no state), then the modal state (G90/G91, M82/M83, G92,
+/// G28) is applied to the moves in file order ([`Part::resolve`]). The moves and the first error
+/// are those of reading the whole file line by line (tested).
 pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
-    let mut moves = Vec::new();
-    let mut pos = DVec3::ZERO;
-    let mut start = None;
-    let mut e = 0.0;
-    let (mut absolute_xyz, mut absolute_e) = (true, true);
+    let cores = crate::parallel::cores().clamp(1, 8);
+    parse_moves_in(text, text.len().div_ceil(cores).max(PART_BYTES))
+}
+
+/// Bytes of text below which the file is read in one part (a thread costs more).
+const PART_BYTES: usize = 1 << 20;
+
+/// [`parse_moves`], in parts of at least `part_bytes` each (whole lines), one thread each.
+fn parse_moves_in(text: &str, part_bytes: usize) -> Result<(Vec<Move>, DVec3), GcodeError> {
+    let mut texts = Vec::new();
+    let mut rest = text;
+    let want = part_bytes.max(1);
+    while rest.len() > want {
+        // Cut after a newline: each part is whole lines.
+        match rest.as_bytes()[want..].iter().position(|&b| b == b'\n') {
+            Some(k) => {
+                let (head, tail) = rest.split_at(want + k + 1);
+                texts.push(head);
+                rest = tail;
+            }
+            None => break,
+        }
+    }
+    texts.push(rest);
+    let read: Vec<Part> = if texts.len() == 1 {
+        vec![read_part(text)]
+    } else {
+        std::thread::scope(|scope| {
+            let (last, others) = texts.split_last().expect("one part or more");
+            let handles: Vec<_> = others
+                .iter()
+                .map(|&t| scope.spawn(move || read_part(t)))
+                .collect();
+            let last = read_part(last);
+            let mut read: Vec<Part> = handles.into_iter().map(crate::parallel::join).collect();
+            read.push(last);
+            read
+        })
+    };
+    let mut state = State::default();
+    let mut moves = Vec::with_capacity(read.iter().map(|p| p.moves.len()).sum());
+    let mut lines_before = 0;
+    for part in read {
+        let lines = part.lines;
+        part.resolve(&mut state, lines_before, &mut moves)?;
+        lines_before += lines;
+    }
+    Ok((moves, state.start.unwrap_or(DVec3::ZERO)))
+}
+
+/// What changes the modal state, read from one line.
+#[derive(Debug, Clone, Copy)]
+enum Modal {
+    AbsoluteXyz(bool),
+    AbsoluteE(bool),
+    /// G92: the axes given (NaN: not given), X Y Z E.
+    SetPosition([f64; 4]),
+    /// G28.
+    Home,
+}
+
+/// One part of the file as read without the modal state.
+struct Part {
+    /// Its moves: `to` the X Y Z given and `de` the E given (NaN where not given), `line` within
+    /// the part.
+    moves: Vec<Move>,
+    /// The state changes, each before move `.0` of the part.
+    modal: Vec<(usize, Modal)>,
+    /// The first error, after all the part's moves.
+    error: Option<GcodeError>,
+    /// Lines in the part.
+    lines: usize,
+}
+
+/// The modal state, as the file sets it up to a line.
+struct State {
+    pos: DVec3,
+    e: f64,
+    absolute_xyz: bool,
+    absolute_e: bool,
+    /// Where the first move starts.
+    start: Option<DVec3>,
+}
+
+impl Default for State {
+    fn default() -> Self {
+        Self {
+            pos: DVec3::ZERO,
+            e: 0.0,
+            absolute_xyz: true,
+            absolute_e: true,
+            start: None,
+        }
+    }
+}
+
+impl State {
+    fn apply(&mut self, modal: Modal) {
+        match modal {
+            Modal::AbsoluteXyz(on) => self.absolute_xyz = on,
+            Modal::AbsoluteE(on) => self.absolute_e = on,
+            Modal::SetPosition([x, y, z, e]) => {
+                if !e.is_nan() {
+                    self.e = e;
+                }
+                for (c, v) in [x, y, z].into_iter().enumerate() {
+                    if !v.is_nan() {
+                        self.pos[c] = v;
+                    }
+                }
+            }
+            Modal::Home => self.pos = DVec3::ZERO,
+        }
+    }
+}
+
+impl Part {
+    /// Applies the modal state to the part's moves in order and appends them to `out`, with
+    /// their lines counted from the file's start; `state` is left as the part leaves it.
+    fn resolve(
+        self,
+        state: &mut State,
+        lines_before: usize,
+        out: &mut Vec<Move>,
+    ) -> Result<(), GcodeError> {
+        let mut modal = self.modal.iter().peekable();
+        for (k, m) in self.moves.into_iter().enumerate() {
+            while let Some((_, change)) = modal.next_if(|(at, _)| *at == k) {
+                state.apply(*change);
+            }
+            let line = m.line + lines_before;
+            let mut to = state.pos;
+            for c in 0..3 {
+                let v = m.to[c];
+                if !v.is_nan() {
+                    to[c] = if state.absolute_xyz { v } else { to[c] + v };
+                }
+            }
+            let de = match m.de {
+                v if v.is_nan() => 0.0,
+                v if state.absolute_e => {
+                    let d = v - state.e;
+                    state.e = v;
+                    d
+                }
+                v => v,
+            };
+            if !to.is_finite() {
+                return Err(GcodeError {
+                    line,
+                    message: "the position runs past any finite number".into(),
+                });
+            }
+            state.start.get_or_insert(state.pos);
+            out.push(Move { to, de, line });
+            state.pos = to;
+        }
+        for (_, change) in modal {
+            state.apply(*change);
+        }
+        match self.error {
+            Some(e) => Err(GcodeError {
+                line: e.line + lines_before,
+                ..e
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Reads the lines of `text` without the modal state (see [`Part`]); stops at the first error.
+fn read_part(text: &str) -> Part {
+    let mut part = Part {
+        moves: Vec::with_capacity(text.len() / 40),
+        modal: Vec::new(),
+        error: None,
+        lines: 0,
+    };
+    if let Err(e) = read_lines(text, &mut part) {
+        part.error = Some(e);
+    }
+    part
+}
+
+fn read_lines(text: &str, part: &mut Part) -> Result<(), GcodeError> {
     for (idx, raw) in text.lines().enumerate() {
         let line = idx + 1;
+        part.lines = line;
         // Drop the comment and a host checksum (`*nn`).
         let code = raw
             .split(';')
@@ -81,7 +267,7 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
             let Some(w) = letters[slot] else {
                 return Ok(None);
             };
-            let v: f64 = w[1..].parse().map_err(|_| GcodeError {
+            let v = crate::decimal::parse_f64(&w[1..]).map_err(|_| GcodeError {
                 line,
                 message: format!("`{}` is not a number", truncated(w)),
             })?;
@@ -94,58 +280,38 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
             Ok(Some(v))
         };
         let is = |name: &str| cmd.eq_ignore_ascii_case(name);
+        let given = |v: Option<f64>| v.unwrap_or(f64::NAN);
         if is("G1") || is("G0") || is("G01") || is("G00") {
             let (x, y, z, ev) = (arg('X')?, arg('Y')?, arg('Z')?, arg('E')?);
-            let mut to = pos;
-            for (v, c) in [(x, 0), (y, 1), (z, 2)] {
-                if let Some(v) = v {
-                    to[c] = if absolute_xyz { v } else { to[c] + v };
-                }
-            }
-            let de = match ev {
-                Some(v) if absolute_e => {
-                    let d = v - e;
-                    e = v;
-                    d
-                }
-                Some(v) => v,
-                None => 0.0,
-            };
-            if !to.is_finite() {
-                return Err(GcodeError {
-                    line,
-                    message: "the position runs past any finite number".into(),
-                });
-            }
-            if start.is_none() {
-                start = Some(pos);
-            }
-            moves.push(Move { to, de, line });
-            pos = to;
+            part.moves.push(Move {
+                to: DVec3::new(given(x), given(y), given(z)),
+                de: given(ev),
+                line,
+            });
         } else if is("G90") {
-            absolute_xyz = true;
+            part.modal
+                .push((part.moves.len(), Modal::AbsoluteXyz(true)));
         } else if is("G91") {
-            absolute_xyz = false;
+            part.modal
+                .push((part.moves.len(), Modal::AbsoluteXyz(false)));
         } else if is("M82") {
-            absolute_e = true;
+            part.modal.push((part.moves.len(), Modal::AbsoluteE(true)));
         } else if is("M83") {
-            absolute_e = false;
+            part.modal.push((part.moves.len(), Modal::AbsoluteE(false)));
         } else if is("G92") {
-            if let Some(v) = arg('E')? {
-                e = v;
-            }
-            for (letter, c) in [('X', 0), ('Y', 1), ('Z', 2)] {
-                if let Some(v) = arg(letter)? {
-                    pos[c] = v;
-                }
-            }
+            let e = arg('E')?;
+            let (x, y, z) = (arg('X')?, arg('Y')?, arg('Z')?);
+            part.modal.push((
+                part.moves.len(),
+                Modal::SetPosition([given(x), given(y), given(z), given(e)]),
+            ));
         } else if is("G20") {
             return Err(GcodeError {
                 line,
                 message: "inch units (G20) are not supported".into(),
             });
         } else if is("G28") {
-            pos = DVec3::ZERO;
+            part.modal.push((part.moves.len(), Modal::Home));
         } else if cmd.starts_with(['G', 'M', 'T', 'N', 'F', 'S', 'g', 'm', 't', 'n', 'f', 's'])
             && cmd[1..].parse::<f64>().is_ok()
         {
@@ -168,12 +334,194 @@ pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
             });
         }
     }
-    Ok((moves, start.unwrap_or(DVec3::ZERO)))
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// The reader as it was before it read in parts: one pass, line by line, with the modal
+    /// state. The reference the parts must match.
+    fn parse_moves_reference(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
+        let mut moves = Vec::new();
+        let mut pos = DVec3::ZERO;
+        let mut start = None;
+        let mut e = 0.0;
+        let (mut absolute_xyz, mut absolute_e) = (true, true);
+        for (idx, raw) in text.lines().enumerate() {
+            let line = idx + 1;
+            // Drop the comment and a host checksum (`*nn`).
+            let code = raw
+                .split(';')
+                .next()
+                .unwrap_or("")
+                .split('*')
+                .next()
+                .unwrap_or("")
+                .trim();
+            if code.is_empty() {
+                continue;
+            }
+            let mut words = code.split_whitespace();
+            let Some(first) = words.next() else {
+                continue;
+            };
+            let mut cmd = first;
+            // The first word of each axis letter after the first word, found in one pass over
+            // the line and parsed only where the command reads it.
+            let mut letters: [Option<&str>; 4] = [None; 4];
+            let mut numbered = cmd.starts_with(['N', 'n']) && cmd[1..].parse::<u64>().is_ok();
+            for w in words {
+                if numbered {
+                    // A line number (`N12 G1 …`) comes before the command.
+                    cmd = w;
+                    numbered = false;
+                }
+                let slot = match w.as_bytes()[0].to_ascii_uppercase() {
+                    b'X' => 0,
+                    b'Y' => 1,
+                    b'Z' => 2,
+                    b'E' => 3,
+                    _ => continue,
+                };
+                letters[slot].get_or_insert(w);
+            }
+            if numbered {
+                continue;
+            }
+            let arg = |letter: char| -> Result<Option<f64>, GcodeError> {
+                let slot = match letter {
+                    'X' => 0,
+                    'Y' => 1,
+                    'Z' => 2,
+                    _ => 3,
+                };
+                let Some(w) = letters[slot] else {
+                    return Ok(None);
+                };
+                let v: f64 = w[1..].parse().map_err(|_| GcodeError {
+                    line,
+                    message: format!("`{}` is not a number", truncated(w)),
+                })?;
+                if !v.is_finite() {
+                    return Err(GcodeError {
+                        line,
+                        message: format!("`{}` is not finite", truncated(w)),
+                    });
+                }
+                Ok(Some(v))
+            };
+            let is = |name: &str| cmd.eq_ignore_ascii_case(name);
+            if is("G1") || is("G0") || is("G01") || is("G00") {
+                let (x, y, z, ev) = (arg('X')?, arg('Y')?, arg('Z')?, arg('E')?);
+                let mut to = pos;
+                for (v, c) in [(x, 0), (y, 1), (z, 2)] {
+                    if let Some(v) = v {
+                        to[c] = if absolute_xyz { v } else { to[c] + v };
+                    }
+                }
+                let de = match ev {
+                    Some(v) if absolute_e => {
+                        let d = v - e;
+                        e = v;
+                        d
+                    }
+                    Some(v) => v,
+                    None => 0.0,
+                };
+                if !to.is_finite() {
+                    return Err(GcodeError {
+                        line,
+                        message: "the position runs past any finite number".into(),
+                    });
+                }
+                if start.is_none() {
+                    start = Some(pos);
+                }
+                moves.push(Move { to, de, line });
+                pos = to;
+            } else if is("G90") {
+                absolute_xyz = true;
+            } else if is("G91") {
+                absolute_xyz = false;
+            } else if is("M82") {
+                absolute_e = true;
+            } else if is("M83") {
+                absolute_e = false;
+            } else if is("G92") {
+                if let Some(v) = arg('E')? {
+                    e = v;
+                }
+                for (letter, c) in [('X', 0), ('Y', 1), ('Z', 2)] {
+                    if let Some(v) = arg(letter)? {
+                        pos[c] = v;
+                    }
+                }
+            } else if is("G20") {
+                return Err(GcodeError {
+                    line,
+                    message: "inch units (G20) are not supported".into(),
+                });
+            } else if is("G28") {
+                pos = DVec3::ZERO;
+            } else if cmd.starts_with(['G', 'M', 'T', 'N', 'F', 'S', 'g', 'm', 't', 'n', 'f', 's'])
+                && cmd[1..].parse::<f64>().is_ok()
+            {
+                // Other numbered commands: no moves.
+            } else if cmd.len() >= 3
+                && cmd.starts_with(|c: char| c.is_ascii_uppercase())
+                && cmd
+                    .chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
+            {
+                // Klipper's and RepRapFirmware's named commands (`SET_PRINT_STATS_INFO …`,
+                // `TURN_OFF_HEATERS`): no moves.
+            } else {
+                return Err(GcodeError {
+                    line,
+                    message: format!(
+                        "`{}` is not a G-code command",
+                        truncated(&cmd.to_ascii_uppercase())
+                    ),
+                });
+            }
+        }
+        Ok((moves, start.unwrap_or(DVec3::ZERO)))
+    }
+
+    /// A line of G-code from a small vocabulary: moves with any of the axes, relative and
+    /// absolute modes, G92, G28, line numbers, comments, checksums, a Klipper command, and
+    /// now and then a word that is not a number or not a command.
+    fn gcode_line() -> impl Strategy<Value = String> {
+        prop_oneof![
+            6 => (0u8..16, -50.0f64..50.0, -50.0f64..50.0, 0.0f64..9.0, -1.0f64..3.0).prop_map(|(axes, x, y, z, e)| {
+                let mut l = String::from(if axes & 1 == 0 { "G1" } else { "g0" });
+                for (bit, word) in [(1, format!(" X{x:.3}")), (2, format!(" Y{y:.3}")), (4, format!(" Z{z:.3}")), (8, format!(" E{e:.5}"))] {
+                    if axes & bit != 0 || bit == 1 {
+                        l.push_str(&word);
+                    }
+                }
+                l
+            }),
+            1 => prop_oneof![Just("G90"), Just("G91"), Just("M82"), Just("M83"), Just("G28"), Just("G92 E0"), Just("G92 X1 Z2"), Just("N7 G1 X1 E1*42 ; numbered"), Just("; a comment"), Just(""), Just("SET_PRINT_STATS_INFO CURRENT_LAYER=3"), Just("M117 Xhello")].prop_map(String::from),
+            1 => prop_oneof![Just("G1 Xhello"), Just("G92 Ebad"), Just("frobnicate"), Just("G20"), Just("G1 X1e400"), Just("G91\nG1 X1e308\nG1 X1e308")].prop_map(String::from),
+        ]
+    }
+
+    proptest! {
+        /// Read in parts of any size (or whole), a file gives the moves, start and first error of
+        /// the one-pass reader: the modal state (relative moves and E, G92, G28) carries across
+        /// the cuts, and the line numbers and the error are the file's.
+        #[test]
+        fn parts_read_as_the_whole_file(lines in proptest::collection::vec(gcode_line(), 0..60), part_bytes in 1usize..200, crlf in any::<bool>()) {
+            let text = lines.join(if crlf { "\r\n" } else { "\n" });
+            let reference = parse_moves_reference(&text);
+            prop_assert_eq!(parse_moves_in(&text, usize::MAX), reference.clone());
+            prop_assert_eq!(parse_moves_in(&text, part_bytes), reference);
+        }
+    }
 
     #[test]
     fn one_pass_reading_keeps_the_words_rules() {
