@@ -546,6 +546,17 @@ struct BodyState {
     next_layer: usize,
 }
 
+impl BodyState {
+    /// Before the first point.
+    const START: BodyState = BodyState {
+        t_done: 0.0,
+        e_total: 0.0,
+        last_speed: f64::NAN,
+        last_percent: u64::MAX,
+        next_layer: 0,
+    };
+}
+
 /// The path part of the program: one `G1` per point with its E and, where they change, the
 /// feed rate, the layer messages and the M73 progress. Chunks of points are formatted on both
 /// cores; the running sums are carried from chunk to chunk in the order the sequential loop adds
@@ -589,44 +600,48 @@ impl<'a> BodyWriter<'a> {
             return Ok(());
         }
         let threads = crate::parallel::cores().clamp(1, 2);
-        let mut state = BodyState {
-            t_done: 0.0,
-            e_total: 0.0,
-            last_speed: f64::NAN,
-            last_percent: u64::MAX,
-            next_layer: 0,
-        };
+        let mut state = BodyState::START;
+        let want_index = index.is_some();
+        // Chunks of equal size, so that the threads finish together.
+        let chunk = (n - 1).div_ceil(threads).clamp(1, BODY_CHUNK);
         let mut start = 1;
         while start < n {
-            // The ranges of this round and the state at the start of each.
-            let mut ranges = Vec::with_capacity(threads);
-            for _ in 0..threads {
-                if start >= n {
-                    break;
+            // The ranges of this round. Each starts from the state the one before it leaves:
+            // while a thread formats a chunk, the calling thread adds up that chunk's sums for
+            // the next one, then formats the last chunk itself.
+            let ranges: Vec<_> = (0..threads)
+                .map(|k| start + k * chunk)
+                .take_while(|&s| s < n)
+                .map(|s| s..(s + chunk).min(n))
+                .collect();
+            let (last, others) = ranges.split_last().expect("a chunk or more");
+            let parts: Vec<(Vec<u8>, Vec<u32>)> = if n < 4096 {
+                let mut parts = Vec::with_capacity(ranges.len());
+                for r in others {
+                    parts.push(self.format(r.clone(), state, want_index));
+                    state = self.advance(state, r.clone());
                 }
-                let end = (start + BODY_CHUNK).min(n);
-                ranges.push((start..end, state));
-                state = self.advance(state, start..end);
-                start = end;
-            }
-            let want_index = index.is_some();
-            let parts: Vec<(Vec<u8>, Vec<u32>)> = if ranges.len() == 1 || n < 4096 {
-                ranges
-                    .into_iter()
-                    .map(|(r, st)| self.format(r, st, want_index))
-                    .collect()
+                parts.push(self.format(last.clone(), state, want_index));
+                parts
             } else {
                 std::thread::scope(|scope| {
-                    let handles: Vec<_> = ranges
-                        .into_iter()
-                        .map(|(r, st)| scope.spawn(move || self.format(r, st, want_index)))
-                        .collect();
-                    handles
-                        .into_iter()
-                        .map(|h| crate::parallel::join(h))
-                        .collect()
+                    let mut handles = Vec::with_capacity(others.len());
+                    for r in others {
+                        let (st, r2) = (state, r.clone());
+                        handles.push(scope.spawn(move || self.format(r2, st, want_index)));
+                        state = self.advance(state, r.clone());
+                    }
+                    let tail = self.format(last.clone(), state, want_index);
+                    let mut parts: Vec<_> =
+                        handles.into_iter().map(crate::parallel::join).collect();
+                    parts.push(tail);
+                    parts
                 })
             };
+            if last.end < n {
+                state = self.advance(state, last.clone());
+            }
+            start = last.end;
             for (text, lines) in parts {
                 out.write_all(&text)?;
                 if let Some(v) = index.as_deref_mut() {
@@ -751,6 +766,50 @@ mod tests {
         let mut b = Vec::new();
         put_fixed(&mut b, v, d);
         String::from_utf8(b).unwrap()
+    }
+
+    /// The body written in rounds of chunks, on both cores, is the body formatted in one piece
+    /// on one: a path of three chunks and more (two rounds, the last short), with progress,
+    /// layer announcements, absolute E carried across the chunks, and speed changes.
+    #[test]
+    fn chunks_write_the_body_in_one_piece() {
+        let mut d = crate::load::parse_design(
+            "version = 1\n[shape]\nheight = 20.0\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 30.0 }\n",
+        )
+        .unwrap();
+        d.printer.extrusion = ExtrusionMode::Absolute;
+        d.printer.progress = true;
+        d.printer.host_metadata = true;
+        let n = 2 * BODY_CHUNK + BODY_CHUNK / 3;
+        let points: Vec<crate::toolpath::PathPoint> = (0..n)
+            .map(|i| {
+                let a = i as f64 * 0.01;
+                crate::toolpath::PathPoint {
+                    pos: DVec3::new(
+                        90.0 + 40.0 * a.cos(),
+                        95.0 + 40.0 * a.sin(),
+                        0.5 + i as f64 * 1e-4,
+                    ),
+                    thickness: 0.5,
+                    flow: 1.0,
+                    speed: if (i / 5000) % 3 == 0 { 15.0 } else { 20.0 },
+                }
+            })
+            .collect();
+        let tp = Toolpath {
+            layer_starts: (0..n).step_by(628).collect(),
+            points,
+            base_points: 0,
+            revolutions: 1,
+            findings: Vec::new(),
+        };
+        let body = BodyWriter::new(&d, &tp, 12_345.0, tp.layer_starts.len());
+        let (mut text, mut index) = (Vec::new(), Vec::new());
+        body.write(&mut text, &mut Some(&mut index)).unwrap();
+        let (whole, whole_index) = body.format(1..n, BodyState::START, true);
+        assert!(text == whole, "the texts differ");
+        assert_eq!(index, whole_index);
+        assert!(text.windows(4).any(|w| w == b"M73 "));
     }
 
     /// The program's line index names, for every line that moves the nozzle along the path, the
