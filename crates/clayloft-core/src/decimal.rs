@@ -244,6 +244,26 @@ mod tests {
     }
 
     #[test]
+    fn fixed_formatting() {
+        assert_eq!(fixed(12.3456, 3), "12.346");
+        assert_eq!(fixed(0.0004, 3), "0.000");
+        assert_eq!(fixed(-0.0004, 3), "0.000");
+        assert_eq!(fixed(-1.5, 3), "-1.500");
+        assert_eq!(fixed(0.05, 5), "0.05000");
+        assert_eq!(fixed(3000.0, 0), "3000");
+        assert_eq!(fixed(7.0, 1), "7.0");
+        assert_eq!(fixed(1e300, 2).len(), format!("{:.2}", 1e300).len());
+        assert_eq!(fixed(123456.789, 3), "123456.789");
+        assert_eq!(fixed(0.00123, 5), "0.00123");
+        assert_eq!(fixed(99.9996, 3), "100.000");
+        for k in 0..2000 {
+            let v = (k as f64 - 1000.0) * 0.7391;
+            let written: f64 = fixed(v, 3).parse().unwrap();
+            assert!((written - v).abs() <= 0.0005 + 1e-9, "{v} -> {written}");
+        }
+    }
+
+    #[test]
     fn plain_decimals_read_back() {
         assert_eq!(parse_f64("-12.345"), Ok(-12.345));
         assert_eq!(parse_f64(".5"), Ok(0.5));

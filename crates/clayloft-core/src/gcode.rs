@@ -762,12 +762,6 @@ impl<'a> BodyWriter<'a> {
 mod tests {
     use super::*;
 
-    fn fixed(v: f64, d: u32) -> String {
-        let mut b = Vec::new();
-        put_fixed(&mut b, v, d);
-        String::from_utf8(b).unwrap()
-    }
-
     /// The body written in rounds of chunks, on both cores, is the body formatted in one piece
     /// on one: a path of three chunks and more (two rounds, the last short), with progress,
     /// layer announcements, absolute E carried across the chunks, and speed changes.
@@ -870,26 +864,6 @@ mod tests {
                 .unwrap()
                 .starts_with("M104 S0\nG91\nG0 Z")
         );
-    }
-
-    #[test]
-    fn fixed_formatting() {
-        assert_eq!(fixed(12.3456, 3), "12.346");
-        assert_eq!(fixed(0.0004, 3), "0.000");
-        assert_eq!(fixed(-0.0004, 3), "0.000");
-        assert_eq!(fixed(-1.5, 3), "-1.500");
-        assert_eq!(fixed(0.05, 5), "0.05000");
-        assert_eq!(fixed(3000.0, 0), "3000");
-        assert_eq!(fixed(7.0, 1), "7.0");
-        assert_eq!(fixed(1e300, 2).len(), format!("{:.2}", 1e300).len());
-        assert_eq!(fixed(123456.789, 3), "123456.789");
-        assert_eq!(fixed(0.00123, 5), "0.00123");
-        assert_eq!(fixed(99.9996, 3), "100.000");
-        for k in 0..2000 {
-            let v = (k as f64 - 1000.0) * 0.7391;
-            let written: f64 = fixed(v, 3).parse().unwrap();
-            assert!((written - v).abs() <= 0.0005 + 1e-9, "{v} -> {written}");
-        }
     }
 
     #[test]
