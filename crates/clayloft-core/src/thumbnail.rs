@@ -54,6 +54,12 @@ pub fn render(points: &[DVec3], w: u32, h: u32) -> image::RgbaImage {
     let offset = DVec2::new(w as f64, h as f64) / 2.0 - (lo + hi) / 2.0 * scale;
     let mut depth_buf = vec![f64::NEG_INFINITY; (w * h) as usize];
     let radius = (w.min(h) as f64 / 110.0).max(0.6);
+    // The pixel offsets of a dot, row by row: those within the radius of its centre.
+    let r = radius.ceil() as i64;
+    let dot: Vec<(i64, i64)> = (-r..=r)
+        .flat_map(|dy| (-r..=r).map(move |dx| (dx, dy)))
+        .filter(|&(dx, dy)| ((dx * dx + dy * dy) as f64) <= radius * radius + 0.5)
+        .collect();
     for p in points.iter().step_by(step) {
         let (s, d) = project(*p);
         let c = s * scale + offset;
@@ -70,26 +76,20 @@ pub fn render(points: &[DVec3], w: u32, h: u32) -> image::RgbaImage {
             (118.0 * light + 20.0) as u8,
             (78.0 * light + 15.0) as u8,
         ];
-        let r = radius.ceil() as i64;
-        for dy in -r..=r {
-            for dx in -r..=r {
-                let (x, y) = ((cx + dx as f64) as i64, (cy + dy as f64) as i64);
-                if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
-                    continue;
-                }
-                if ((dx * dx + dy * dy) as f64) > radius * radius + 0.5 {
-                    continue;
-                }
-                let k = (y as u32 * w + x as u32) as usize;
-                // Nearer to the viewer = smaller depth value: keep the nearest.
-                if -d > depth_buf[k] {
-                    depth_buf[k] = -d;
-                    img.put_pixel(
-                        x as u32,
-                        y as u32,
-                        image::Rgba([rgb[0], rgb[1], rgb[2], 255]),
-                    );
-                }
+        for &(dx, dy) in &dot {
+            let (x, y) = ((cx + dx as f64) as i64, (cy + dy as f64) as i64);
+            if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+                continue;
+            }
+            let k = (y as u32 * w + x as u32) as usize;
+            // Nearer to the viewer = smaller depth value: keep the nearest.
+            if -d > depth_buf[k] {
+                depth_buf[k] = -d;
+                img.put_pixel(
+                    x as u32,
+                    y as u32,
+                    image::Rgba([rgb[0], rgb[1], rgb[2], 255]),
+                );
             }
         }
     }
