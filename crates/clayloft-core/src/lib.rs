@@ -14,8 +14,8 @@
 //! 6. [`toolpath`] joins the sections into one spiral (with a [`base_fill`] under it and, for a
 //!    wall of several beads, the [`walls`] inward of the surface), [`gcode`] writes it between the
 //!    dialect's [`templates`] with the host metadata and a [`thumbnail`], timed by [`motion`]
-//!    as firmware plans it; [`stl`] meshes the wall; [`check`] re-measures any G-code file
-//!    against the printer's limits.
+//!    as firmware plans it, its numbers written (and read back) by [`decimal`]; [`stl`] meshes
+//!    the wall; [`check`] re-measures any G-code file against the printer's limits.
 //!
 //! [`pipeline`] is the loop over these stages; [`session`] runs them incrementally, redoing only
 //! what an edit changed.
