@@ -25,9 +25,9 @@ pub struct Move {
 
 /// Parses the moves of a G-code program (G0/G1 with G90/G91, M82/M83, G92, G20/G21).
 ///
-/// Read in two steps: the lines are read in parts, one per core ([`read_part`]: the words and
+/// Read in two steps: the lines are read in parts, one per core (`read_part`: the words and
 /// numbers of each line, which need no state), then the modal state (G90/G91, M82/M83, G92,
-/// G28) is applied to the moves in file order ([`Part::resolve`]). The moves and the first error
+/// G28) is applied to the moves in file order (`Part::resolve`). The moves and the first error
 /// are those of reading the whole file line by line (tested).
 pub fn parse_moves(text: &str) -> Result<(Vec<Move>, DVec3), GcodeError> {
     let cores = crate::parallel::cores().clamp(1, 8);
