@@ -336,7 +336,7 @@ fn edge_xy(e: u64, stride: u64) -> (isize, isize) {
 }
 
 /// Smooths an outline without rounding its corners: points where the outline turns by more than
-/// [`CORNER_DEG`] over ±4 points stay put; the others are averaged with their neighbours
+/// `CORNER_DEG` over ±4 points stay put; the others are averaged with their neighbours
 /// (`pᵢ ← ¼pᵢ₋₁ + ½pᵢ + ¼pᵢ₊₁`, three passes), which removes pixel and JPEG noise.
 pub fn smooth_keeping_corners(points: &[DVec2]) -> Vec<DVec2> {
     let n = points.len();

@@ -33,7 +33,7 @@ pub struct CheckReport {
 }
 
 /// One point of the path that broke a limit: where (G-code line, or point index for
-/// [`check_path`]), which limit and by how much (degrees or mm).
+/// [`check_path`](super::check_path)), which limit and by how much (degrees or mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathEvent {
     pub line: usize,
