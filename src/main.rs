@@ -13,7 +13,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use clayloft_core::check::{Limits, check_gcode};
-use clayloft_core::gcode::{format_duration, summarize, write_gcode};
+use clayloft_core::gcode::{JobSummary, format_duration, summarize, write_gcode_summarized};
 use clayloft_core::stl::{job_mesh, write_ascii_stl, write_binary_stl};
 use clayloft_core::{LoadedDesign, PrintJob, load_design};
 
@@ -284,9 +284,11 @@ fn clay_bodies() -> Result<ExitCode, Failure> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
+/// What `info` and `gcode` print about a job; `summary` is the writer's when it has run (the
+/// same figures, without a second run of the motion planner).
+fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSummary>) {
     let d = &loaded.design;
-    let s = summarize(d, job);
+    let s = summary.unwrap_or_else(|| summarize(d, job));
     let m = &job.surface.metrics;
     println!("design: {} ({})", d.name, loaded.path.display());
     if let Some(profile) = &d.printer.profile {
@@ -372,7 +374,7 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob) {
 fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
     let (loaded, job) = job_of(design, printer)?;
     let mut text = Vec::with_capacity(job.toolpath.points.len() * 40 + 65_536);
-    write_gcode(&loaded.design, &job, &mut text)?;
+    let summary = write_gcode_summarized(&loaded.design, &job, &mut text)?;
     let d = &loaded.design;
     if d.constraints.enforce {
         // Right first time: the file is re-measured by the checker before it is written; a
@@ -396,7 +398,7 @@ fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, F
         }
     }
     clayloft_core::atomic::write_atomically(out, |w| w.write_all(&text))?;
-    print_summary(&loaded, &job);
+    print_summary(&loaded, &job, Some(summary));
     println!("wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
 }
@@ -465,7 +467,7 @@ fn check(path: &Path, design: Option<&Path>) -> Result<ExitCode, Failure> {
 /// `clayloft info [DESIGN]`: what the design would print.
 fn overview(design: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
     let (loaded, job) = job_of(design, printer)?;
-    print_summary(&loaded, &job);
+    print_summary(&loaded, &job, None);
     Ok(ExitCode::SUCCESS)
 }
 

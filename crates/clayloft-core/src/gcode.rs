@@ -248,15 +248,26 @@ pub fn template_values(design: &Design, job: &PrintJob, summary: &JobSummary) ->
 /// start G-code, approach, the one continuous path (with progress and layer messages), exit,
 /// end G-code. Coordinates are in the printer's own frame (SPEC §12).
 pub fn write_gcode(design: &Design, job: &PrintJob, out: &mut dyn Write) -> io::Result<()> {
+    write_gcode_summarized(design, job, out).map(|_| ())
+}
+
+/// [`write_gcode`], returning the figures of its header (the same as [`summarize`] gives): a
+/// caller that reports them needs no second run of the motion planner.
+pub fn write_gcode_summarized(
+    design: &Design,
+    job: &PrintJob,
+    out: &mut dyn Write,
+) -> io::Result<JobSummary> {
     write_program(design, job, out).map_err(io::Error::from)
 }
 
-/// [`write_gcode`] with its errors kept apart (a template that cannot be filled names its field).
+/// [`write_gcode_summarized`] with its errors kept apart (a template that cannot be filled names
+/// its field).
 pub fn write_program(
     design: &Design,
     job: &PrintJob,
     out: &mut dyn Write,
-) -> Result<(), GcodeWriteError> {
+) -> Result<JobSummary, GcodeWriteError> {
     write_program_indexed(design, job, out, None)
 }
 
@@ -321,7 +332,7 @@ fn write_program_indexed(
     job: &PrintJob,
     out: &mut dyn Write,
     mut index: Option<&mut Vec<u32>>,
-) -> Result<(), GcodeWriteError> {
+) -> Result<JobSummary, GcodeWriteError> {
     let p = &design.printer;
     let tp = &job.toolpath;
     // The motion planner (the time estimate) and the thumbnails are independent: one core each.
@@ -524,7 +535,7 @@ fn write_program_indexed(
     }
     buf.extend_from_slice(b"; end\n");
     out.write_all(&buf)?;
-    Ok(())
+    Ok(summary)
 }
 
 /// Points formatted per chunk; two chunks at a time go to the two threads (bounded memory: a
@@ -879,6 +890,16 @@ mod tests {
         .unwrap();
         let j = crate::pipeline::run(&d).unwrap();
         (d, j)
+    }
+
+    #[test]
+    fn the_writer_returns_the_summary_it_wrote() {
+        let (d, j) = job("[texture]\n[texture.x]\nwave = \"sine\"\nperiod = 6\namplitude = 1.0\n");
+        let mut v = Vec::new();
+        let s = write_gcode_summarized(&d, &j, &mut v).unwrap();
+        assert_eq!(s, summarize(&d, &j));
+        let text = String::from_utf8(v).unwrap();
+        assert!(text.contains(&format!("({:.0} s,", s.estimated_time_s)));
     }
 
     fn gcode(d: &Design, j: &PrintJob) -> String {
