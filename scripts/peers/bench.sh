@@ -9,7 +9,8 @@ cd "$(dirname "$0")/../.."
 target="${CARGO_TARGET_DIR:-$HOME/.cache/clayloft-target}"
 clayloft="$target/release/clayloft"
 [ -x "$clayloft" ] || cargo build --release -p clayloft
-command -v prusa-slicer >/dev/null || sudo apt-get install -y --no-install-recommends prusa-slicer
+as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
+command -v prusa-slicer >/dev/null || as_root apt-get install -y --no-install-recommends prusa-slicer
 venv="${PEERS_VENV:-$target/peers-venv}"
 [ -x "$venv/bin/python" ] || { python3 -m venv "$venv" && "$venv/bin/pip" install -q fullcontrol; }
 work="$(mktemp -d)"
