@@ -214,49 +214,47 @@ fn read_part(text: &str) -> Part {
     part
 }
 
+/// The command of a G-code line and the first word of each axis letter after it (X, Y, Z, E),
+/// found in one pass over the line (each is parsed only where the command reads it). None for a
+/// line with no command: blank, a comment, a bare line number. The comment and a host checksum
+/// (`*nn`) are dropped; a line number (`N12 G1 …`) before the command is passed over.
+fn words_of(raw: &str) -> Option<(&str, [Option<&str>; 4])> {
+    let code = raw
+        .split(';')
+        .next()
+        .unwrap_or("")
+        .split('*')
+        .next()
+        .unwrap_or("")
+        .trim();
+    let mut words = code.split_whitespace();
+    let mut cmd = words.next()?;
+    let mut letters: [Option<&str>; 4] = [None; 4];
+    let mut numbered = cmd.starts_with(['N', 'n']) && cmd[1..].parse::<u64>().is_ok();
+    for w in words {
+        if numbered {
+            cmd = w;
+            numbered = false;
+        }
+        let slot = match w.as_bytes()[0].to_ascii_uppercase() {
+            b'X' => 0,
+            b'Y' => 1,
+            b'Z' => 2,
+            b'E' => 3,
+            _ => continue,
+        };
+        letters[slot].get_or_insert(w);
+    }
+    (!numbered).then_some((cmd, letters))
+}
+
 fn read_lines(text: &str, part: &mut Part) -> Result<(), GcodeError> {
     for (idx, raw) in text.lines().enumerate() {
         let line = idx + 1;
         part.lines = line;
-        // Drop the comment and a host checksum (`*nn`).
-        let code = raw
-            .split(';')
-            .next()
-            .unwrap_or("")
-            .split('*')
-            .next()
-            .unwrap_or("")
-            .trim();
-        if code.is_empty() {
-            continue;
-        }
-        let mut words = code.split_whitespace();
-        let Some(first) = words.next() else {
+        let Some((cmd, letters)) = words_of(raw) else {
             continue;
         };
-        let mut cmd = first;
-        // The first word of each axis letter after the first word, found in one pass over
-        // the line and parsed only where the command reads it.
-        let mut letters: [Option<&str>; 4] = [None; 4];
-        let mut numbered = cmd.starts_with(['N', 'n']) && cmd[1..].parse::<u64>().is_ok();
-        for w in words {
-            if numbered {
-                // A line number (`N12 G1 …`) comes before the command.
-                cmd = w;
-                numbered = false;
-            }
-            let slot = match w.as_bytes()[0].to_ascii_uppercase() {
-                b'X' => 0,
-                b'Y' => 1,
-                b'Z' => 2,
-                b'E' => 3,
-                _ => continue,
-            };
-            letters[slot].get_or_insert(w);
-        }
-        if numbered {
-            continue;
-        }
         let arg = |letter: char| -> Result<Option<f64>, GcodeError> {
             let slot = match letter {
                 'X' => 0,
@@ -352,45 +350,9 @@ mod tests {
         let (mut absolute_xyz, mut absolute_e) = (true, true);
         for (idx, raw) in text.lines().enumerate() {
             let line = idx + 1;
-            // Drop the comment and a host checksum (`*nn`).
-            let code = raw
-                .split(';')
-                .next()
-                .unwrap_or("")
-                .split('*')
-                .next()
-                .unwrap_or("")
-                .trim();
-            if code.is_empty() {
-                continue;
-            }
-            let mut words = code.split_whitespace();
-            let Some(first) = words.next() else {
+            let Some((cmd, letters)) = words_of(raw) else {
                 continue;
             };
-            let mut cmd = first;
-            // The first word of each axis letter after the first word, found in one pass over
-            // the line and parsed only where the command reads it.
-            let mut letters: [Option<&str>; 4] = [None; 4];
-            let mut numbered = cmd.starts_with(['N', 'n']) && cmd[1..].parse::<u64>().is_ok();
-            for w in words {
-                if numbered {
-                    // A line number (`N12 G1 …`) comes before the command.
-                    cmd = w;
-                    numbered = false;
-                }
-                let slot = match w.as_bytes()[0].to_ascii_uppercase() {
-                    b'X' => 0,
-                    b'Y' => 1,
-                    b'Z' => 2,
-                    b'E' => 3,
-                    _ => continue,
-                };
-                letters[slot].get_or_insert(w);
-            }
-            if numbered {
-                continue;
-            }
             let arg = |letter: char| -> Result<Option<f64>, GcodeError> {
                 let slot = match letter {
                     'X' => 0,
