@@ -189,52 +189,83 @@ fn entry_limits(
         }
     }
     let mut prev = from(range.start);
-    let (mut cached_cap2, mut cached_threshold) = (f64::NAN, f64::INFINITY);
+    let mut corners = Corners::new(a, deviation, last_dir, last_speed2);
     for (k, i) in range.enumerate() {
         let m = moves.get(i);
         let d = m.to - prev;
         let l = d.length();
-        let v2 = m.speed * m.speed;
+        legs.entry2[k] = corners.entry2(d, l, m.speed * m.speed);
+        legs.len[k] = l;
+        legs.speed[k] = m.speed;
+        prev = m.to;
+    }
+}
+
+/// The corner limits along a run of moves, move after move: the direction and squared speed of
+/// the last move that goes somewhere, and the threshold of the last cap (consecutive moves mostly
+/// share their speeds, so it is rarely computed again).
+struct Corners {
+    a: f64,
+    deviation: f64,
+    last_dir: Option<DVec3>,
+    last_speed2: f64,
+    cached_cap2: f64,
+    cached_threshold: f64,
+}
+
+impl Corners {
+    fn new(a: f64, deviation: f64, last_dir: Option<DVec3>, last_speed2: f64) -> Self {
+        Self {
+            a,
+            deviation,
+            last_dir,
+            last_speed2,
+            cached_cap2: f64::NAN,
+            cached_threshold: f64::INFINITY,
+        }
+    }
+
+    /// The squared speed the next move (`d`, `l` = |d| long, squared speed `v2`) may enter at:
+    /// its own speed, the speed before it and the corner allow. It then becomes the last move.
+    fn entry2(&mut self, d: DVec3, l: f64, v2: f64) -> f64 {
         let limit2 = if l == 0.0 {
             // A move that goes nowhere passes the speed on unchanged.
-            if last_dir.is_some() {
+            if self.last_dir.is_some() {
                 f64::INFINITY
             } else {
                 0.0
             }
         } else {
             let w = d * (1.0 / l);
-            let j2 = match last_dir {
+            let j2 = match self.last_dir {
                 None => 0.0,
                 Some(u) => {
-                    let cap2 = v2.min(last_speed2);
-                    if cap2 != cached_cap2 {
-                        cached_cap2 = cap2;
-                        cached_threshold = cap_threshold(cap2, a, deviation);
+                    let cap2 = v2.min(self.last_speed2);
+                    if cap2 != self.cached_cap2 {
+                        self.cached_cap2 = cap2;
+                        self.cached_threshold = cap_threshold(cap2, self.a, self.deviation);
                     }
                     // Most junctions of a smooth path turn too little for the limit to bind.
                     let sin_half2 = (1.0 + u.dot(w).clamp(-1.0, 1.0)) / 2.0;
-                    if sin_half2 >= cached_threshold {
+                    if sin_half2 >= self.cached_threshold {
                         cap2
                     } else {
-                        junction_speed2(u, w, a, deviation, cap2)
+                        junction_speed2(u, w, self.a, self.deviation, cap2)
                     }
                 }
             };
-            last_dir = Some(w);
+            self.last_dir = Some(w);
             j2
         };
-        legs.entry2[k] = limit2.min(v2).min(if l == 0.0 {
+        let entry = limit2.min(v2).min(if l == 0.0 {
             f64::INFINITY
         } else {
-            last_speed2.max(v2)
+            self.last_speed2.max(v2)
         });
-        legs.len[k] = l;
-        legs.speed[k] = m.speed;
-        prev = m.to;
         if l > 0.0 {
-            last_speed2 = v2;
+            self.last_speed2 = v2;
         }
+        entry
     }
 }
 
@@ -286,53 +317,14 @@ mod tests {
         // entry2[i]: squared speed entering move i; entry2[n] = 0 (the job ends at rest).
         let mut entry2 = Vec::with_capacity(hint + 1);
         let mut prev = start;
-        let mut last_dir: Option<DVec3> = None;
-        let mut last_speed2 = 0.0;
-        let (mut cached_cap2, mut cached_threshold) = (f64::NAN, f64::INFINITY);
+        let mut corners = Corners::new(a, deviation, None, 0.0);
         for m in moves {
             let d = m.to - prev;
             let l = d.length();
-            let v2 = m.speed * m.speed;
-            let limit2 = if l == 0.0 {
-                // A move that goes nowhere passes the speed on unchanged.
-                if last_dir.is_some() {
-                    f64::INFINITY
-                } else {
-                    0.0
-                }
-            } else {
-                let w = d * (1.0 / l);
-                let j2 = match last_dir {
-                    None => 0.0,
-                    Some(u) => {
-                        let cap2 = v2.min(last_speed2);
-                        if cap2 != cached_cap2 {
-                            cached_cap2 = cap2;
-                            cached_threshold = cap_threshold(cap2, a, deviation);
-                        }
-                        // Most junctions of a smooth path turn too little for the limit to bind.
-                        let sin_half2 = (1.0 + u.dot(w).clamp(-1.0, 1.0)) / 2.0;
-                        if sin_half2 >= cached_threshold {
-                            cap2
-                        } else {
-                            junction_speed2(u, w, a, deviation, cap2)
-                        }
-                    }
-                };
-                last_dir = Some(w);
-                j2
-            };
-            entry2.push(limit2.min(v2).min(if l == 0.0 {
-                f64::INFINITY
-            } else {
-                last_speed2.max(v2)
-            }));
+            entry2.push(corners.entry2(d, l, m.speed * m.speed));
             len.push(l);
             speed.push(m.speed);
             prev = m.to;
-            if l > 0.0 {
-                last_speed2 = v2;
-            }
         }
         let n = len.len();
         entry2.push(0.0);
