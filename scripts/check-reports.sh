@@ -5,7 +5,7 @@
 # pipeline and compare: `diff -r before after` must be empty for a change that claims to be
 # exact (a speed-up, a refactor).
 #
-#   scripts/check-reports.sh /tmp/before   # on the old commit
+#   scripts/check-reports.sh /tmp/before   # on the old commit (or CLAYLOFT_BIN=old-binary)
 #   scripts/check-reports.sh /tmp/after    # on the new one
 #   diff -r /tmp/before /tmp/after
 set -euo pipefail
@@ -13,8 +13,14 @@ cd "$(dirname "$0")/.."
 out=${1:?usage: scripts/check-reports.sh OUTDIR}
 mkdir -p "$out"
 target=${CARGO_TARGET_DIR:-$HOME/.cache/clayloft-target}
-cargo build --release --quiet
-bin="$target/release/clayloft"
+# CLAYLOFT_BIN names another build to report on (an old commit's binary kept for the comparison)
+# without building this checkout.
+if [ -n "${CLAYLOFT_BIN:-}" ]; then
+  bin="$CLAYLOFT_BIN"
+else
+  cargo build --release --quiet
+  bin="$target/release/clayloft"
+fi
 wild="$out/wild.toml"
 # The benchmark vase pushed past every limit: texture amplitude 6 mm, rose amplitude 20 mm.
 sed -e 's/^amplitude = 0.8/amplitude = 6.0/' -e 's/^amplitude = 8.0/amplitude = 20.0/' \
