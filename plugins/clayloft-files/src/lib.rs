@@ -220,7 +220,9 @@ pub fn save_design(design: &Design, path: &Path) -> Result<Design, String> {
 pub fn export_gcode(design: &Design, job: &PrintJob, path: &Path) -> Result<String, String> {
     let mut summary = None;
     write_atomically(path, |w| {
-        summary = Some(clayloft_core::gcode::write_gcode_summarized(design, job, w)?);
+        summary = Some(clayloft_core::gcode::write_gcode_summarized(
+            design, job, w,
+        )?);
         Ok(())
     })
     .map_err(|e| e.to_string())?;
