@@ -18,11 +18,11 @@ pub struct WriteError {
 }
 
 /// Writes `path` by calling `fill` with a buffered writer on a temporary file, then renames it
-/// into place.
-pub fn write_atomically(
+/// into place; returns what `fill` returned (a writer's figures, say).
+pub fn write_atomically<T>(
     path: &Path,
-    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), WriteError> {
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<T>,
+) -> Result<T, WriteError> {
     let err = |reason: String| WriteError {
         file: path.display().to_string(),
         reason,
@@ -53,13 +53,14 @@ pub fn write_atomically(
             .set_permissions(p)
             .map_err(|e| err(e.to_string()))?;
     }
-    {
+    let filled = {
         let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
-        fill(&mut w).map_err(|e| err(e.to_string()))?;
+        let filled = fill(&mut w).map_err(|e| err(e.to_string()))?;
         w.flush().map_err(|e| err(e.to_string()))?;
-    }
+        filled
+    };
     tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
-    Ok(())
+    Ok(filled)
 }
 
 #[cfg(test)]
@@ -73,7 +74,7 @@ mod tests {
         write_atomically(&out, |w| w.write_all(b"hello")).unwrap();
         assert_eq!(std::fs::read(&out).unwrap(), b"hello");
         let failed = dir.path().join("b.txt");
-        let r = write_atomically(&failed, |w| {
+        let r: Result<(), _> = write_atomically(&failed, |w| {
             w.write_all(b"half")?;
             Err(std::io::Error::other("disk full"))
         });

@@ -218,15 +218,10 @@ pub fn save_design(design: &Design, path: &Path) -> Result<Design, String> {
 
 /// Writes the G-code of a job, as `clayloft gcode` does.
 pub fn export_gcode(design: &Design, job: &PrintJob, path: &Path) -> Result<String, String> {
-    let mut summary = None;
-    write_atomically(path, |w| {
-        summary = Some(clayloft_core::gcode::write_gcode_summarized(
-            design, job, w,
-        )?);
-        Ok(())
+    let s = write_atomically(path, |w| {
+        clayloft_core::gcode::write_gcode_summarized(design, job, w)
     })
     .map_err(|e| e.to_string())?;
-    let s = summary.unwrap_or_else(|| clayloft_core::gcode::summarize(design, job));
     Ok(format!(
         "wrote {} ({} points, {:.1} m of path)",
         path.display(),
