@@ -303,4 +303,59 @@ mod tests {
             passes + 1
         );
     }
+
+    /// The replay's checker runs on a thread of its own and only while the replay is shown:
+    /// editing a design with the replay hidden never waits for it, and once shown the replay
+    /// flags what the checker flags.
+    #[test]
+    fn the_replay_checks_the_path_in_the_background_while_shown() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs/petal-vase.toml");
+        let design = clayloft_core::load_design(&path).unwrap().design;
+        let mut app = headless(design);
+        for _ in 0..5 {
+            app.update();
+        }
+        // Hidden: the path is not checked.
+        assert!(
+            app.world()
+                .resource::<clayloft_replay::ReplayPath>()
+                .checking
+        );
+        // A steeper wall than the printer allows (enforcement off), so that there is something
+        // to flag, then the replay shown.
+        {
+            let mut doc = app.world_mut().resource_mut::<DesignDoc>();
+            doc.design.constraints.enforce = false;
+            doc.design.printer.max_overhang_deg = 5.0;
+        }
+        app.update();
+        assert!(
+            app.world()
+                .resource::<clayloft_replay::ReplayPath>()
+                .checking
+        );
+        app.world_mut()
+            .resource_mut::<clayloft_replay::Replay>()
+            .active = true;
+        let start = std::time::Instant::now();
+        while app
+            .world()
+            .resource::<clayloft_replay::ReplayPath>()
+            .checking
+        {
+            assert!(start.elapsed().as_secs() < 60, "the check never finished");
+            std::thread::sleep(std::time::Duration::from_millis(5));
+            app.update();
+        }
+        let design = app.world().resource::<DesignDoc>().design.clone();
+        let mut q = app.world_mut().query::<&clayloft_model::ToolpathPath>();
+        let toolpath = q.single(app.world()).unwrap().0.clone();
+        let expected = clayloft_replay::ReplayPath::new(&toolpath, &design.printer).events;
+        assert!(!expected.is_empty());
+        assert_eq!(
+            app.world().resource::<clayloft_replay::ReplayPath>().events,
+            expected
+        );
+    }
 }

@@ -344,7 +344,7 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
             }
         );
     }
-    if let Ok(p) = clayloft_core::printability::assess(d, &job.toolpath) {
+    if let Some(p) = &job.verdict {
         println!("{}", p.summary());
         if let Some(w) = p.warning(d) {
             println!("{w}");

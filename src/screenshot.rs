@@ -84,6 +84,10 @@ fn drive_screenshot(
         replay.active = true;
         replay.playing = false;
         replay.time_s = f.clamp(0.0, 1.0) * path.timeline.total_s();
+        // The flags the replay shows come from the checker, on a thread of its own.
+        if path.checking {
+            return;
+        }
     }
     // The flow window's simulation: wait until it has converged (or run long enough to show
     // its vortex).

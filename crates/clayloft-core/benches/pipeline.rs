@@ -170,6 +170,7 @@ fn gcode_writing(c: &mut Criterion) {
             point_leans_deg: Vec::new(),
         }),
         beads: std::sync::Arc::new(Vec::new()),
+        verdict: None,
         toolpath: std::sync::Arc::new(Toolpath {
             points,
             base_points: 0,

@@ -57,6 +57,7 @@ pub mod thumbnail;
 pub mod toolpath;
 pub mod trace;
 pub mod validate;
+pub mod view_mesh;
 pub mod walls;
 
 pub use design::Design;

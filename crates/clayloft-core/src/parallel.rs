@@ -60,6 +60,23 @@ pub fn map_ranges<R: Send>(
     })
 }
 
+/// `a()` and `b()`, `a` on a second thread when `beside` (else both on this one, `a` first).
+pub fn both<A: Send, B>(
+    beside: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B,
+) -> (A, B) {
+    if !beside {
+        let a = a();
+        return (a, b());
+    }
+    std::thread::scope(|scope| {
+        let handle = scope.spawn(a);
+        let b = b();
+        (join(handle), b)
+    })
+}
+
 /// `f(offset, part)` on contiguous parts of `items`, one per core (`offset`: the index of the
 /// part's first item).
 pub fn for_each_part<T: Send>(

@@ -41,6 +41,9 @@ pub struct PrintJob {
     /// The wall's inner beads ([`crate::walls::inner_beads`]): empty for a one-bead wall.
     pub beads: Arc<Vec<Vec<Section>>>,
     pub toolpath: Arc<Toolpath>,
+    /// Whether the wet wall stands while the toolpath is printed (SPEC §14); `None` for a clay
+    /// body that does not resolve (validation reports it).
+    pub verdict: Option<Arc<crate::printability::Printability>>,
 }
 
 impl PrintJob {

@@ -17,7 +17,10 @@
 //! 4. the surface: overhang correction, texture, metrics, fit on the machine
 //!    (`pipeline::finish_surface`);
 //! 5. the base fill of the feet (`toolpath::base_fills`), kept while the feet do not change;
-//! 6. the toolpath: the one continuous spiral (`toolpath::build_toolpath_on`).
+//! 6. the toolpath: the one continuous spiral (`toolpath::build_toolpath_on`);
+//! 7. the verdict: whether the wet wall stands while it is printed (`printability::assess`);
+//! 8. for a session made [`Session::with_wall_view`], the wall's mesh for a 3D view
+//!    (`view_mesh::wall_buffers`), so that an application's view and replay share one.
 //!
 //! The batch [`crate::run`] is a fresh session's first update.
 
@@ -29,11 +32,13 @@ use glam::DVec2;
 use crate::design::{BedShape, ContourSpec, Design, HorizontalLine, Origin, Texture, VerticalLine};
 use crate::loft::{LoftInput, SampledContour, sample_contour};
 use crate::pipeline::{PrintJob, Surface, finish_sections};
+use crate::printability::Printability;
 use crate::report::Finding;
 use crate::section::Section;
 use crate::shape::ShapeModel;
 use crate::toolpath::{Toolpath, build_toolpath_on};
 use crate::validate::{FieldError, validate};
+use crate::view_mesh::WallBuffers;
 
 /// The two contours, in the order of [`Session::contour`].
 pub const CONTOUR_FIELDS: [&str; 2] = ["shape.lower", "shape.upper"];
@@ -65,7 +70,7 @@ impl<K: PartialEq, V> Stage<K, V> {
         key: K,
         compute: impl FnOnce() -> Result<V, FieldError>,
     ) -> Result<bool, FieldError> {
-        if self.value.is_some() && self.key.as_ref() == Some(&key) {
+        if self.is_current(&key) {
             return Ok(false);
         }
         self.key = None;
@@ -75,6 +80,11 @@ impl<K: PartialEq, V> Stage<K, V> {
         self.key = Some(key);
         self.value = Some(value);
         Ok(true)
+    }
+
+    /// Whether the value was computed from `key` (a [`Stage::refresh`] would not run).
+    fn is_current(&self, key: &K) -> bool {
+        self.value.is_some() && self.key.as_ref() == Some(key)
     }
 
     fn get(&self) -> Option<&V> {
@@ -191,6 +201,10 @@ pub struct Update {
     pub beads: bool,
     /// The spiral toolpath was rebuilt.
     pub toolpath: bool,
+    /// The printability verdict was redone (a new toolpath, or another clay body).
+    pub verdict: bool,
+    /// The view's mesh of the wall was rebuilt ([`Session::with_wall_view`]).
+    pub wall_view: bool,
 }
 
 impl Update {
@@ -210,6 +224,30 @@ struct LaterStages {
     base: Stage<BaseKey, Vec<crate::base_fill::BaseFill>>,
     beads: Stage<BeadKey, Arc<Vec<Vec<Section>>>>,
     toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
+    /// Whether the wet wall stands while the toolpath is printed (`None` for a clay body that
+    /// does not resolve: validation reports it).
+    verdict: Stage<VerdictKey, Option<Arc<Printability>>>,
+    /// The wall's mesh for a view (kept only by a session made [`Session::with_wall_view`]).
+    view: Stage<WallViewKey, Arc<WallBuffers>>,
+}
+
+/// Inputs of the printability verdict: the toolpath (by revision), the clay body and the wall's
+/// thickness.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VerdictKey {
+    pub toolpath: u64,
+    pub clay: Option<crate::clay::ClayTable>,
+    pub walls: usize,
+    pub line_width: f64,
+}
+
+/// Inputs of the view's mesh: the surface and the beads (by revision) and the overhang limit
+/// its colours mark.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WallViewKey {
+    pub surface: u64,
+    pub beads: u64,
+    pub limit_deg: f64,
 }
 
 /// Inputs of a mesh: the file (and when it last changed, so an edited file is read again) and
@@ -262,6 +300,8 @@ pub struct Session {
     /// The error of the last update, if it failed.
     error: Option<FieldError>,
     updates: u64,
+    /// Whether the wall's mesh for a view is kept ([`Session::with_wall_view`]).
+    wall_view: bool,
 }
 
 impl Session {
@@ -292,6 +332,7 @@ impl Session {
                     surface: self.later.surface.get().expect("updated").clone(),
                     beads: self.later.beads.get().expect("updated").clone(),
                     toolpath: self.later.toolpath.get().expect("updated").clone(),
+                    verdict: self.later.verdict.get().expect("updated").clone(),
                 });
                 if self.design.as_ref() != Some(design)
                     || self.design.as_ref().map(|d| &d.base_dir) != Some(&design.base_dir)
@@ -408,6 +449,7 @@ impl Session {
         let surface_inputs = (plan_revision, self.sections_revision);
         finish_stages(
             &mut self.later,
+            self.wall_view,
             design,
             &mut done,
             grid,
@@ -421,6 +463,27 @@ impl Session {
             plan_findings,
         )?;
         Ok(done)
+    }
+
+    /// A session that also keeps the wall's mesh for a 3D view ([`crate::view_mesh`]), rebuilt
+    /// with the surface: what an interactive application shows (the command line does without).
+    pub fn with_wall_view() -> Session {
+        Session {
+            wall_view: true,
+            ..Session::default()
+        }
+    }
+
+    /// The wall's mesh for a view as of the last successful update (a session made
+    /// [`Session::with_wall_view`]; `None` otherwise).
+    pub fn wall_view(&self) -> Option<&Arc<WallBuffers>> {
+        self.later.view.get()
+    }
+
+    /// Whether the wet wall of the current toolpath stands while it is printed (SPEC §14), as of
+    /// the last successful update; `None` before one, or for a clay body that does not resolve.
+    pub fn printability(&self) -> Option<&Arc<Printability>> {
+        self.later.verdict.get().and_then(Option::as_ref)
     }
 
     /// The current job (the last complete one if the last update failed).
@@ -556,6 +619,7 @@ impl Session {
         let wall = self.mesh_wall.get().expect("the wall stage ran above");
         finish_stages(
             &mut self.later,
+            self.wall_view,
             design,
             done,
             grid,
@@ -569,8 +633,10 @@ impl Session {
 /// The stages every design shares once its shaped sections are known: the texture's
 /// displacements, the corrected surface (its key holds the revisions `inputs` of what the
 /// sections came from), the base fill and the toolpath.
+#[allow(clippy::too_many_arguments)]
 fn finish_stages(
     later: &mut LaterStages,
+    wall_view: bool,
     design: &Design,
     done: &mut Update,
     grid: crate::pipeline::SectionGrid,
@@ -653,6 +719,52 @@ fn finish_stages(
     done.toolpath = later.toolpath.refresh(key, || {
         build_toolpath_on(design, &surface, fills, beads).map(Arc::new)
     })?;
+
+    // 6. Whether the wet wall stands while it is printed, and 7. the wall's mesh for a view
+    // (after the beads: a wall of several shows its inner bead). Each runs on one core, so they
+    // run side by side. (The mesh built beside the toolpath measured no faster: the toolpath's
+    // stages use both cores already.)
+    let toolpath = later.toolpath.get().expect("the toolpath stage ran above");
+    let verdict_key = VerdictKey {
+        toolpath: later.toolpath.revision,
+        clay: design.clay.clone(),
+        walls: design.shape.walls,
+        line_width: p.line_width,
+    };
+    let view_key = wall_view.then_some(WallViewKey {
+        surface: later.surface.revision,
+        beads: later.beads.revision,
+        limit_deg: p.max_overhang_deg,
+    });
+    let points: usize = surface.sections.iter().map(|s| s.points.len()).sum();
+    let beside = crate::parallel::cores() > 1
+        && points >= PARALLEL_POINTS
+        && !later.verdict.is_current(&verdict_key)
+        && view_key.as_ref().is_some_and(|k| !later.view.is_current(k));
+    let (verdict, view) = (&mut later.verdict, &mut later.view);
+    let (verdict, view) = crate::parallel::both(
+        beside,
+        || {
+            verdict.refresh(verdict_key, || {
+                Ok(crate::printability::assess(design, toolpath)
+                    .ok()
+                    .map(Arc::new))
+            })
+        },
+        || {
+            view_key.map(|key| {
+                view.refresh(key, || {
+                    Ok(Arc::new(crate::view_mesh::wall_buffers(
+                        &surface,
+                        beads.last().map(Vec::as_slice),
+                        p.max_overhang_deg,
+                    )))
+                })
+            })
+        },
+    );
+    done.verdict = verdict?;
+    done.wall_view = view.transpose()?.unwrap_or(false);
     Ok(())
 }
 
@@ -706,7 +818,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
     /// The edits a user makes, one per case; some make the design invalid or unprintable.
     fn edit(d: &mut Design, which: u8, amount: f64) {
         let a = amount; // in [0, 1)
-        match which % 24 {
+        match which % 25 {
             0 => {
                 d.shape.lower = ContourSpec::Circle {
                     radius: 20.0 + 10.0 * a,
@@ -767,6 +879,13 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
             20 => d.printer.nozzle_length = 5.0 + 30.0 * a,
             21 => d.shape.walls = 1 + (a * 3.0) as usize,
             22 => d.shape.wall_ties = a < 0.5 && d.shape.walls > 1,
+            // The clay stiffening faster or slower: only the verdict.
+            23 => {
+                d.clay = Some(crate::clay::ClayTable {
+                    structuration_rate: Some(0.05 + 2.0 * a),
+                    ..Default::default()
+                })
+            }
             _ => d.printer.max_layer_height = 1.2 + a,
         }
     }
@@ -784,6 +903,23 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
                     *job.toolpath, *b.toolpath,
                     "toolpath differs from a batch run"
                 );
+                // The session works on the wet design (SPEC §14).
+                let wet = crate::clay::wet_design(d).unwrap();
+                assert_eq!(
+                    session.printability().map(|p| &**p),
+                    crate::printability::assess(&wet, &b.toolpath).ok().as_ref(),
+                    "verdict differs from a batch run"
+                );
+                let mesh = crate::view_mesh::wall_buffers(
+                    &b.surface,
+                    b.beads.last().map(Vec::as_slice),
+                    wet.printer.max_overhang_deg,
+                );
+                assert_eq!(
+                    session.wall_view().map(|m| &**m),
+                    Some(&mesh),
+                    "view mesh differs from a batch run"
+                );
                 assert!(session.is_current());
             }
             (Err(e), Err(b)) => {
@@ -796,14 +932,15 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
 
     proptest! {
         #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
-        /// Incremental equals batch: after every edit of a random sequence, the session's job is
-        /// exactly (bit for bit) the job a fresh run computes, and both fail alike.
+        /// Incremental equals batch: after every edit of a random sequence, the session's job,
+        /// verdict and view mesh are exactly (bit for bit) what a fresh run computes, and both
+        /// fail alike.
         #[test]
         fn incremental_updates_equal_a_batch_run(
-            edits in proptest::collection::vec((0u8..24, 0.0f64..1.0), 1..12)
+            edits in proptest::collection::vec((0u8..25, 0.0f64..1.0), 1..12)
         ) {
             let mut d = design();
-            let mut session = Session::new();
+            let mut session = Session::with_wall_view();
             let first = session.update(&d);
             assert_same_as_batch(&session, &d, &first);
             for (which, amount) in edits {
@@ -840,13 +977,27 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         e.printer.max_overhang_deg = 40.0;
         let u = s.update(&e).unwrap();
         assert!(!u.plan && u.sections.is_empty() && u.surface && u.toolpath);
-        // The speed: only the toolpath.
+        // The speed: only the toolpath and its verdict.
         e.printer.print_speed = 25.0;
         let u = s.update(&e).unwrap();
         assert_eq!(
             u,
             Update {
                 toolpath: true,
+                verdict: true,
+                ..Update::default()
+            }
+        );
+        // The clay stiffening faster: only the verdict.
+        e.clay = Some(crate::clay::ClayTable {
+            structuration_rate: Some(1.5),
+            ..Default::default()
+        });
+        let u = s.update(&e).unwrap();
+        assert_eq!(
+            u,
+            Update {
+                verdict: true,
                 ..Update::default()
             }
         );
@@ -858,6 +1009,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
             Update {
                 beads: true,
                 toolpath: true,
+                verdict: true,
                 ..Update::default()
             }
         );
@@ -875,6 +1027,29 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         let u = s.update(&e).unwrap();
         assert_eq!(u.contours, vec!["shape.upper"]);
         assert!(u.plan && u.sections.len() == s.model().unwrap().layers + 1);
+        // A session without a view keeps no mesh.
+        assert!(!u.wall_view && s.wall_view().is_none());
+    }
+
+    #[test]
+    fn the_view_mesh_follows_the_surface_the_beads_and_the_limit() {
+        let d = design();
+        let mut s = Session::with_wall_view();
+        assert!(s.update(&d).unwrap().wall_view);
+        let first = s.wall_view().unwrap().clone();
+        // The speed: a new toolpath, the same mesh (shared, not rebuilt).
+        let mut e = d.clone();
+        e.printer.print_speed = 25.0;
+        assert!(!s.update(&e).unwrap().wall_view);
+        assert!(Arc::ptr_eq(&first, s.wall_view().unwrap()));
+        // The limit the colours mark: a new mesh (and a corrected surface).
+        e.printer.max_overhang_deg = 40.0;
+        assert!(s.update(&e).unwrap().wall_view);
+        // A second bead: the mesh shows its inner sheet.
+        e.shape.walls = 2;
+        let u = s.update(&e).unwrap();
+        assert!(u.wall_view && !u.surface);
+        assert!(s.wall_view().unwrap().positions.len() > first.positions.len());
     }
 
     #[test]

@@ -60,6 +60,11 @@ pub struct Vessel;
 #[derive(Component, Debug, Clone)]
 pub struct VesselSurface(pub Arc<Surface>);
 
+/// The wall's mesh for the view (the core's [`clayloft_core::view_mesh`], built by the session
+/// beside the toolpath), on the vessel entity: shared by the 3D view and the replay.
+#[derive(Component, Debug, Clone)]
+pub struct VesselMesh(pub Arc<clayloft_core::view_mesh::WallBuffers>);
+
 /// The wall's inner beads (SPEC §13), on the vessel entity: `[j − 1][k]` is bead `j`'s section
 /// `k`; empty for a one-bead wall.
 #[derive(Component, Debug, Clone, Default)]
@@ -77,9 +82,9 @@ impl VesselBeads {
 pub struct ToolpathPath(pub Arc<Toolpath>);
 
 /// Whether the wet wall of the toolpath stands while it is printed (SPEC §14), on the toolpath
-/// entity: judged once per toolpath by the core.
+/// entity: the session's verdict, redone for a new toolpath or clay body.
 #[derive(Component, Debug, Clone)]
-pub struct ToolpathPrintability(pub clayloft_core::printability::Printability);
+pub struct ToolpathPrintability(pub Arc<clayloft_core::printability::Printability>);
 
 /// Which kind of control line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

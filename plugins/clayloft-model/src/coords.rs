@@ -4,16 +4,17 @@
 
 use bevy::math::{DVec3, Vec3};
 
-/// Design-space point (mm, z up) to a Bevy world position.
+/// Design-space point (mm, z up) to a Bevy world position: the core's view frame
+/// ([`clayloft_core::view_mesh::to_view`]), in which the wall's mesh comes.
 #[inline]
 pub fn to_world(p: DVec3) -> Vec3 {
-    Vec3::new(p.x as f32, p.z as f32, -p.y as f32)
+    clayloft_core::view_mesh::to_view(p)
 }
 
 /// Bevy world position to a design-space point (mm, z up).
 #[inline]
 pub fn from_world(w: Vec3) -> DVec3 {
-    DVec3::new(w.x as f64, -w.z as f64, w.y as f64)
+    clayloft_core::view_mesh::from_view(w)
 }
 
 #[cfg(test)]

@@ -1,186 +1,24 @@
-//! The wall as a triangle mesh for the 3D view, coloured by how far each point leans from
-//! vertical (the overhang of SPEC §2). Plain buffers, so the benchmark and tests need no GPU.
+//! The core's previews as Bevy assets: the wall's mesh (built by the session,
+//! [`clayloft_core::view_mesh`]) and the toolpath as coloured lines.
 
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
-use clayloft_core::pipeline::Surface;
-use clayloft_core::section::Section;
+use clayloft_core::view_mesh::WallBuffers;
 
 use crate::coords::to_world;
 
-/// Vertex and index buffers of the wall, in world coordinates.
-#[derive(Debug, Clone, Default)]
-pub struct WallBuffers {
-    pub positions: Vec<[f32; 3]>,
-    pub normals: Vec<[f32; 3]>,
-    pub colors: Vec<[f32; 4]>,
-    pub indices: Vec<u32>,
-    /// Points whose lean exceeds the limit.
-    pub violating: usize,
-    /// Indices of one row of quads (between sections k and k + 1), all sheets.
-    pub indices_per_row: usize,
-}
-
-/// Colour of a wall point leaning `lean` degrees when the limit is `limit` degrees: clay when
-/// upright, through amber towards the limit, red past it.
-pub fn lean_color(lean: f32, limit: f32) -> [f32; 4] {
-    let clay = [0.80, 0.52, 0.38];
-    let amber = [0.95, 0.75, 0.20];
-    let red = [0.90, 0.08, 0.08];
-    if lean > limit + 0.5 {
-        return [red[0], red[1], red[2], 1.0];
-    }
-    let f = (lean / limit.max(1e-3)).clamp(0.0, 1.0);
-    // Stay clay-coloured up to 60 % of the limit, then blend to amber at the limit.
-    let w = ((f - 0.6) / 0.4).clamp(0.0, 1.0);
-    let mix = |a: f32, b: f32| a + (b - a) * w;
-    [
-        mix(clay[0], amber[0]),
-        mix(clay[1], amber[1]),
-        mix(clay[2], amber[2]),
-        1.0,
-    ]
-}
-
-/// Colour of a wall layer whose safety factor against collapse or buckling is `f` (SPEC §14):
-/// clay where it holds with margin (F ≥ 2), through amber towards 1, red where it fails.
-pub fn safety_color(f: f64) -> [f32; 4] {
-    let clay = [0.80, 0.52, 0.38];
-    let amber = [0.95, 0.75, 0.20];
-    let red = [0.90, 0.08, 0.08];
-    if f < 1.0 {
-        return [red[0], red[1], red[2], 1.0];
-    }
-    let w = ((2.0 - f) as f32).clamp(0.0, 1.0);
-    let mix = |a: f32, b: f32| a + (b - a) * w;
-    [
-        mix(clay[0], amber[0]),
-        mix(clay[1], amber[1]),
-        mix(clay[2], amber[2]),
-        1.0,
-    ]
-}
-
-impl WallBuffers {
-    /// Recolours the wall by the safety factor of each vertex's layer.
-    pub fn colour_by_safety(&mut self, p: &clayloft_core::printability::Printability) {
-        for (c, pos) in self.colors.iter_mut().zip(&self.positions) {
-            // World y is the design's z.
-            *c = safety_color(p.factor_at(pos[1] as f64));
-        }
-    }
-}
-
-/// Builds the wall buffers: one vertex per surface point, two triangles per quad between
-/// consecutive sections (closed around), normals from central differences. With an `innermost`
-/// bead (a wall of several beads, SPEC §13) its sheet follows, facing inward and coloured by the
-/// outer bead's lean, so the wall shows its thickness; each row's triangles of both sheets are
-/// consecutive ([`WallBuffers::indices_per_row`]) so that a replay can show the rows printed.
-pub fn wall_buffers(
-    surface: &Surface,
-    innermost: Option<&[Section]>,
-    limit_deg: f64,
-) -> WallBuffers {
-    let sections = &surface.sections;
-    let rows = sections.len();
-    let n = sections.first().map_or(0, |s| s.points.len());
-    if rows < 2 || n < 3 {
-        return WallBuffers::default();
-    }
-    let innermost = innermost.filter(|b| b.len() == rows && b.iter().all(|s| s.points.len() == n));
-    // The surface's own leans (measured once by the core); a surface put together by hand may
-    // lack them.
-    let computed;
-    let leans = if surface.point_leans_deg.len() == rows * n {
-        &surface.point_leans_deg
-    } else {
-        computed = clayloft_core::constraint::point_leans_deg(sections);
-        &computed
-    };
-    let limit = limit_deg as f32;
-    let sheets: Vec<&[Section]> = std::iter::once(sections.as_slice())
-        .chain(innermost)
-        .collect();
-    let mut b = WallBuffers {
-        indices_per_row: sheets.len() * n * 6,
-        violating: leans.iter().filter(|a| **a > limit + 0.5).count(),
-        ..WallBuffers::default()
-    };
-    for (sheet, rings) in sheets.iter().enumerate() {
-        let outward = if sheet == 0 { 1.0 } else { -1.0 };
-        let first = b.positions.len();
-        b.positions.extend(
-            rings
-                .iter()
-                .flat_map(|s| s.points.iter().map(|p| to_world(*p).to_array())),
-        );
-        let at = |k: usize, i: usize| Vec3::from_array(b.positions[first + k * n + i]);
-        let mut normals = Vec::with_capacity(rows * n);
-        for k in 0..rows {
-            let (kd, ku) = (k.saturating_sub(1), (k + 1).min(rows - 1));
-            for i in 0..n {
-                let (before, after) = clayloft_core::geometry::ring_neighbours(i, n);
-                let around = at(k, after) - at(k, before);
-                let up = at(ku, i) - at(kd, i);
-                // Contours run counter-clockwise seen from above: around × up points outward.
-                normals.push((outward * around.cross(up).normalize_or_zero()).to_array());
-            }
-        }
-        b.normals.extend(normals);
-        b.colors.extend(leans.iter().map(|a| lean_color(*a, limit)));
-    }
-    b.indices.reserve((rows - 1) * b.indices_per_row);
-    for k in 0..rows - 1 {
-        for sheet in 0..sheets.len() {
-            let base = sheet * rows * n;
-            let (r0, r1) = ((base + k * n) as u32, (base + (k + 1) * n) as u32);
-            for i in 0..n as u32 {
-                let j = if i + 1 == n as u32 { 0 } else { i + 1 };
-                if sheet == 0 {
-                    b.indices
-                        .extend_from_slice(&[r0 + i, r0 + j, r1 + j, r0 + i, r1 + j, r1 + i]);
-                } else {
-                    b.indices
-                        .extend_from_slice(&[r0 + i, r1 + j, r0 + j, r0 + i, r1 + i, r1 + j]);
-                }
-            }
-        }
-    }
-    if sheets.len() > 1 {
-        // The rim between the sheets, facing up (last, so a replay shows it with the top row).
-        let top = rows - 1;
-        let first = b.positions.len() as u32;
-        for sheet in 0..2 {
-            for i in 0..n {
-                let v = sheet * rows * n + top * n + i;
-                b.positions.push(b.positions[v]);
-                b.normals.push(Vec3::Y.to_array());
-                b.colors.push(b.colors[v]);
-            }
-        }
-        let (o, inner) = (first, first + n as u32);
-        for i in 0..n as u32 {
-            let j = (i + 1) % n as u32;
-            b.indices
-                .extend_from_slice(&[o + i, inner + j, inner + i, o + i, o + j, inner + j]);
-        }
-    }
-    b
-}
-
-impl WallBuffers {
-    /// A Bevy mesh that keeps its data on the CPU too, so it can be rewritten in place.
-    pub fn into_mesh(self) -> Mesh {
-        Mesh::new(
-            PrimitiveTopology::TriangleList,
-            RenderAssetUsages::default(),
-        )
-        .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, self.positions)
-        .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, self.normals)
-        .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, self.colors)
-        .with_inserted_indices(Indices::U32(self.indices))
-    }
+/// The wall's buffers as a Bevy mesh that keeps its data on the CPU too, so it can be
+/// rewritten in place.
+pub fn wall_mesh(b: WallBuffers) -> Mesh {
+    Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, b.positions)
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, b.normals)
+    .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, b.colors)
+    .with_inserted_indices(Indices::U32(b.indices))
 }
 
 /// The spiral toolpath as a coloured line strip in world coordinates: blue at the foot to warm
@@ -197,98 +35,4 @@ pub fn toolpath_line(path: &clayloft_core::toolpath::Toolpath) -> Vec<(Vec3, Col
             )
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn colours_run_from_clay_to_red() {
-        let close = |a: [f32; 4], b: [f32; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6);
-        assert!(close(lean_color(0.0, 45.0), [0.80, 0.52, 0.38, 1.0]));
-        assert!(close(lean_color(20.0, 45.0), [0.80, 0.52, 0.38, 1.0]));
-        assert!(close(lean_color(45.0, 45.0), [0.95, 0.75, 0.20, 1.0]));
-        assert!(close(lean_color(50.0, 45.0), [0.90, 0.08, 0.08, 1.0]));
-    }
-
-    #[test]
-    fn a_wall_that_fails_is_red_at_its_foot_and_clay_at_its_rim() {
-        assert_eq!(safety_color(0.9), [0.90, 0.08, 0.08, 1.0]);
-        assert_eq!(safety_color(2.5), [0.80, 0.52, 0.38, 1.0]);
-        assert_eq!(safety_color(1.0), [0.95, 0.75, 0.20, 1.0]);
-        let d = clayloft_core::load::parse_design(
-            "version = 1\n[printer]\nmax_z = 1000.0\n[shape]\nheight = 400.0\nsamples = 60\n\
-             lower = { type = \"circle\", radius = 60.0 }\nupper = { type = \"circle\", radius = 60.0 }\n\
-             [clay]\nbody = \"porcelain\"\nstructuration_rate = 0.05\n",
-        )
-        .unwrap();
-        let job = clayloft_core::run(&d).unwrap();
-        let p = clayloft_core::printability::assess(&d, &job.toolpath).unwrap();
-        assert!(p.factor < 1.0);
-        let mut b = wall_buffers(&job.surface, None, 45.0);
-        b.colour_by_safety(&p);
-        let n = 60;
-        assert_eq!(b.colors[n], safety_color(0.0), "the foot fails");
-        assert_eq!(
-            b.colors[b.colors.len() - 1],
-            safety_color(10.0),
-            "the rim holds"
-        );
-    }
-
-    #[test]
-    fn cylinder_mesh_has_outward_normals_and_closed_rings() {
-        let d = clayloft_core::load::parse_design(
-            "version = 1\n[shape]\nheight = 10.0\nsamples = 36\nbase_layers = 0\n\
-             lower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
-        )
-        .unwrap();
-        let s = clayloft_core::pipeline::build_surface(&d).unwrap();
-        let b = wall_buffers(&s, None, 45.0);
-        assert_eq!(b.positions.len(), 36 * 11);
-        assert_eq!(b.indices.len(), 36 * 10 * 6);
-        assert_eq!(b.violating, 0);
-        let c = crate::coords::to_world(s.center.extend(0.0));
-        for (p, nrm) in b.positions.iter().zip(&b.normals) {
-            let radial = (Vec3::from_array(*p) - c).with_y(0.0).normalize();
-            assert!(radial.dot(Vec3::from_array(*nrm)) > 0.999, "{p:?} {nrm:?}");
-        }
-    }
-
-    #[test]
-    fn a_two_bead_wall_shows_an_inner_sheet_facing_inward_a_bead_inside() {
-        let d = clayloft_core::load::parse_design(
-            "version = 1\n[shape]\nheight = 10.0\nsamples = 36\nbase_layers = 0\nwalls = 2\n\
-             lower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
-        )
-        .unwrap();
-        let job = clayloft_core::run(&d).unwrap();
-        let b = wall_buffers(&job.surface, job.beads.last().map(Vec::as_slice), 45.0);
-        // Two sheets and the rim between them.
-        assert_eq!(b.positions.len(), 2 * 36 * 11 + 2 * 36);
-        assert_eq!(b.indices_per_row, 2 * 36 * 6);
-        assert_eq!(b.indices.len(), 10 * b.indices_per_row + 36 * 6);
-        let c = crate::coords::to_world(job.surface.center.extend(0.0));
-        for (p, nrm) in b.positions[36 * 11..2 * 36 * 11]
-            .iter()
-            .zip(&b.normals[36 * 11..])
-        {
-            let off = (Vec3::from_array(*p) - c).with_y(0.0);
-            // The sampled circle's offset: within the chord's sagitta of 17 mm.
-            assert!((off.length() - 17.0).abs() < 0.1, "{p:?}");
-            assert!(
-                off.normalize().dot(Vec3::from_array(*nrm)) < -0.999,
-                "{nrm:?}"
-            );
-        }
-        // Every triangle winds counter-clockwise (Bevy's front face) round its vertices' normal:
-        // the outside faces out, the inside in, the rim up.
-        let v = |i: u32| Vec3::from_array(b.positions[i as usize]);
-        for t in b.indices.chunks(3) {
-            let face = (v(t[1]) - v(t[0])).cross(v(t[2]) - v(t[0]));
-            let nrm = Vec3::from_array(b.normals[t[0] as usize]);
-            assert!(face.dot(nrm) > 0.0, "{t:?}");
-        }
-    }
 }

@@ -12,9 +12,16 @@ use clayloft_core::session::Update;
 use crate::components::*;
 use crate::document::{DesignDoc, ModelStatus};
 
-/// The core's incremental engine for the design being edited.
-#[derive(Resource, Debug, Default)]
+/// The core's incremental engine for the design being edited (keeping the wall's mesh for the
+/// view too).
+#[derive(Resource, Debug)]
 pub struct Engine(pub Session);
+
+impl Default for Engine {
+    fn default() -> Self {
+        Engine(Session::with_wall_view())
+    }
+}
 
 impl Engine {
     /// The session's job for exactly this design (what exports and the printer use: nothing is
@@ -142,6 +149,13 @@ pub fn recompute_model(
             .entity(*vessel)
             .insert(VesselSurface(Arc::clone(surface)));
     }
+    if update.wall_view
+        && let Some(mesh) = session.wall_view()
+    {
+        commands
+            .entity(*vessel)
+            .insert(VesselMesh(Arc::clone(mesh)));
+    }
     if update.beads
         && let Some(beads) = session.beads()
     {
@@ -152,16 +166,17 @@ pub fn recompute_model(
     if update.toolpath
         && let Some(path) = session.toolpath()
     {
+        commands
+            .entity(*toolpath)
+            .insert(ToolpathPath(Arc::clone(path)));
+    }
+    if update.verdict {
         let mut e = commands.entity(*toolpath);
-        e.insert(ToolpathPath(Arc::clone(path)));
-        match session
-            .design()
-            .map(|d| clayloft_core::printability::assess(d, path))
-        {
-            Some(Ok(p)) => {
-                e.insert(ToolpathPrintability(p));
+        match session.printability() {
+            Some(p) => {
+                e.insert(ToolpathPrintability(Arc::clone(p)));
             }
-            _ => {
+            None => {
                 e.remove::<ToolpathPrintability>();
             }
         }

@@ -354,7 +354,13 @@ fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
             format!("{} at point {} ({:.1})", e.what, e.line, e.value),
         );
     }
-    if path.events.is_empty() {
+    if path.checking {
+        ui.label(if replay.active {
+            "checking the path for collisions and overhangs …"
+        } else {
+            "the path is checked for collisions and overhangs when the replay is shown"
+        });
+    } else if path.events.is_empty() {
         ui.colored_label(
             egui::Color32::from_rgb(150, 220, 150),
             "no collision, overhang or unsupported point on this path",

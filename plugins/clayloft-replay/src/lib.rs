@@ -3,15 +3,21 @@
 //! play, pause, scrub. The printed part grows behind it, layer by layer. Every point where the
 //! holder would hit the part, or the path overhangs or has nothing under it, is found by the same
 //! checker as `clayloft check` ([`clayloft_core::check::check_path`]); passing one is flagged on
-//! screen and listed.
+//! screen and listed. The checker measures every point against the layers below it (tens of
+//! milliseconds to seconds): it runs on a thread of its own, and only while the replay is shown,
+//! so that editing never waits for it.
 
 pub mod timeline;
+
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::{Arc, Mutex};
 
 use bevy::picking::Pickable;
 use bevy::prelude::*;
 use clayloft_core::check::{Limits, PathEvent, check_path};
+use clayloft_core::view_mesh::WallBuffers;
 use clayloft_model::coords::to_world;
-use clayloft_model::preview::{WallBuffers, wall_buffers};
+use clayloft_model::preview::wall_mesh;
 use clayloft_model::*;
 use clayloft_view::ViewSettings;
 
@@ -45,6 +51,8 @@ impl Default for Replay {
 pub struct ReplayPath {
     pub timeline: Timeline,
     pub events: Vec<PathEvent>,
+    /// The checker has not yet measured this path (`events` is empty until it has).
+    pub checking: bool,
     /// Index of the path point the nozzle is at (or just past).
     pub index: usize,
     /// Events passed so far (an index into `events`).
@@ -57,10 +65,19 @@ impl ReplayPath {
         path: &clayloft_core::toolpath::Toolpath,
         printer: &clayloft_core::design::Printer,
     ) -> ReplayPath {
-        let points: Vec<_> = path.points.iter().map(|p| p.pos).collect();
+        ReplayPath {
+            events: flagged_points(path, &Limits::from(printer)),
+            checking: false,
+            ..ReplayPath::unchecked(path)
+        }
+    }
+
+    /// The replay of a toolpath before the checker has measured it: its timeline only.
+    pub fn unchecked(path: &clayloft_core::toolpath::Toolpath) -> ReplayPath {
         ReplayPath {
             timeline: Timeline::new(path),
-            events: check_path(&points, &Limits::from(printer)).events,
+            events: Vec::new(),
+            checking: true,
             index: 0,
             passed: 0,
         }
@@ -87,6 +104,23 @@ impl ReplayPath {
     }
 }
 
+/// Every point of `path` the checker flags (collisions, overhangs, unsupported points), in path
+/// order.
+pub fn flagged_points(path: &clayloft_core::toolpath::Toolpath, limits: &Limits) -> Vec<PathEvent> {
+    let points: Vec<_> = path.points.iter().map(|p| p.pos).collect();
+    check_path(&points, limits).events
+}
+
+/// The checker's run for the replay, on a thread of its own: one at a time; a path edited
+/// while one runs waits for it (its result then is dropped) and is checked next.
+#[derive(Resource, Default)]
+struct ReplayCheck {
+    /// The path to check next (it changed since the running check started).
+    wanted: Option<(Arc<clayloft_core::toolpath::Toolpath>, Limits)>,
+    /// The running check, and whether it is of the current path.
+    running: Option<(Mutex<Receiver<Vec<PathEvent>>>, bool)>,
+}
+
 /// Marker of the nozzle's root entity (at the tip).
 #[derive(Component, Debug, Clone, Copy)]
 pub struct Nozzle;
@@ -102,7 +136,8 @@ pub struct PrintedPart;
 /// The full wall buffers the printed part is cut from, and the rows shown.
 #[derive(Resource, Debug, Clone, Default)]
 struct PrintedSource {
-    buffers: WallBuffers,
+    /// The session's mesh of the wall (shared with the view).
+    buffers: Arc<WallBuffers>,
     samples: usize,
     rows_shown: usize,
 }
@@ -120,11 +155,13 @@ impl Plugin for ReplayPlugin {
         app.init_resource::<Replay>()
             .init_resource::<ReplayPath>()
             .init_resource::<PrintedSource>()
+            .init_resource::<ReplayCheck>()
             .add_systems(Startup, spawn_nozzle)
             .add_systems(
                 Update,
                 (
                     prepare_replay_path,
+                    check_replay_path,
                     advance_replay,
                     follow_path,
                     grow_printed_part,
@@ -230,27 +267,70 @@ const HOLDER_HEIGHT: f32 = 35.0;
 
 fn prepare_replay_path(
     path: Query<&ToolpathPath, Changed<ToolpathPath>>,
-    vessel: Query<(&VesselSurface, Option<&VesselBeads>)>,
+    vessel: Query<(&VesselSurface, &VesselMesh)>,
     doc: Option<Res<DesignDoc>>,
     mut replay_path: ResMut<ReplayPath>,
     mut source: ResMut<PrintedSource>,
     mut replay: ResMut<Replay>,
+    mut check: ResMut<ReplayCheck>,
 ) {
     let (Some(path), Some(doc)) = (path.iter().next(), doc) else {
         return;
     };
-    *replay_path = ReplayPath::new(&path.0, &doc.design.printer);
+    *replay_path = ReplayPath::unchecked(&path.0);
+    check.wanted = Some((Arc::clone(&path.0), Limits::from(&doc.design.printer)));
+    if let Some((_, current)) = &mut check.running {
+        *current = false;
+    }
     replay.time_s = replay.time_s.min(replay_path.timeline.total_s());
-    if let Some((surface, beads)) = vessel.iter().next() {
+    if let Some((surface, mesh)) = vessel.iter().next() {
         *source = PrintedSource {
-            buffers: wall_buffers(
-                &surface.0,
-                beads.and_then(VesselBeads::innermost),
-                doc.design.printer.max_overhang_deg,
-            ),
+            buffers: Arc::clone(&mesh.0),
             samples: surface.0.sections.first().map_or(0, |s| s.points.len()),
             rows_shown: usize::MAX,
         };
+    }
+}
+
+/// Takes the finished check of the current path, and starts the next one while the replay is
+/// shown; while one runs, asks for frames so that it is polled (the app draws on input only).
+fn check_replay_path(
+    replay: Res<Replay>,
+    mut path: ResMut<ReplayPath>,
+    mut check: ResMut<ReplayCheck>,
+    redraw: Option<ResMut<Messages<bevy::window::RequestRedraw>>>,
+) {
+    if let Some((rx, current)) = &mut check.running {
+        let result = rx
+            .get_mut()
+            .map_or(Err(TryRecvError::Disconnected), |r| r.try_recv());
+        match result {
+            Err(TryRecvError::Empty) => {}
+            // A check that stopped without a result (it cannot: it reads no input) flags nothing.
+            Ok(_) | Err(TryRecvError::Disconnected) => {
+                if *current {
+                    path.events = result.unwrap_or_default();
+                    path.checking = false;
+                    path.passed = path.events.partition_point(|e| e.line <= path.index);
+                }
+                check.running = None;
+            }
+        }
+    }
+    if check.running.is_none()
+        && replay.active
+        && let Some((toolpath, limits)) = check.wanted.take()
+    {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(flagged_points(&toolpath, &limits));
+        });
+        check.running = Some((Mutex::new(rx), true));
+    }
+    if check.running.is_some()
+        && let Some(mut redraw) = redraw
+    {
+        redraw.write(bevy::window::RequestRedraw);
     }
 }
 
@@ -364,9 +444,9 @@ fn grow_printed_part(
     }
     source.rows_shown = rows;
     let quads = rows.saturating_sub(1) * source.buffers.indices_per_row;
-    let mut b = source.buffers.clone();
+    let mut b = (*source.buffers).clone();
     b.indices.truncate(quads);
-    let _ = meshes.insert(part.0.id(), b.into_mesh());
+    let _ = meshes.insert(part.0.id(), wall_mesh(b));
 }
 
 fn swap_wall_for_printed_part(

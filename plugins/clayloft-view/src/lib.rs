@@ -7,7 +7,7 @@ use bevy::picking::Pickable;
 use bevy::prelude::*;
 use bevy_panorbit_camera::PanOrbitCamera;
 use clayloft_model::coords::to_world;
-use clayloft_model::preview::{toolpath_line, wall_buffers};
+use clayloft_model::preview::{toolpath_line, wall_mesh};
 use clayloft_model::*;
 
 /// What the view shows; the panels toggle these.
@@ -277,32 +277,22 @@ fn frame_camera_on_first_surface(
 }
 
 /// The vessel's wall: its surface and beads, with change ticks.
-type Wall<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Ref<'static, VesselSurface>,
-        Option<Ref<'static, VesselBeads>>,
-    ),
->;
-
 fn rebuild_wall_mesh(
-    vessel: Wall,
+    vessel: Query<Ref<VesselMesh>>,
     verdict: Query<Ref<ToolpathPrintability>>,
-    (settings, doc): (Res<ViewSettings>, Option<Res<DesignDoc>>),
+    settings: Res<ViewSettings>,
     wall: Single<&Mesh3d, With<WallView>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut stats: ResMut<WallStats>,
     mut rebuilds: ResMut<ViewRebuilds>,
     mut coloured_by_safety: Local<bool>,
 ) {
-    let (Some((surface, beads)), Some(doc)) = (vessel.iter().next(), doc) else {
+    let Some(mesh) = vessel.iter().next() else {
         return;
     };
     let verdict = verdict.iter().next();
     let by_safety = settings.colour_by_safety && verdict.is_some();
-    let changed = surface.is_changed()
-        || beads.as_ref().is_some_and(|b| b.is_changed())
+    let changed = mesh.is_changed()
         || (by_safety && verdict.as_ref().is_some_and(|v| v.is_changed()))
         || by_safety != *coloured_by_safety;
     if !changed {
@@ -310,16 +300,13 @@ fn rebuild_wall_mesh(
     }
     *coloured_by_safety = by_safety;
     rebuilds.wall_mesh += 1;
-    let mut buffers = wall_buffers(
-        &surface.0,
-        beads.as_deref().and_then(VesselBeads::innermost),
-        doc.design.printer.max_overhang_deg,
-    );
+    // The session's buffers are shared with the replay: the asset gets its own copy.
+    let mut buffers = (*mesh.0).clone();
     stats.violating_points = buffers.violating;
     if by_safety && let Some(v) = verdict {
         buffers.colour_by_safety(&v.0);
     }
-    let _ = meshes.insert(wall.0.id(), buffers.into_mesh());
+    let _ = meshes.insert(wall.0.id(), wall_mesh(buffers));
 }
 
 /// While the design being edited cannot be built, the wall shown is the last one that could: it
