@@ -46,8 +46,8 @@ fn drag(app: &mut App, role: HandleRole, delta: DVec3) {
     nudge_handle(app.world_mut(), role, delta);
 }
 
-/// What the view does with a new wall and toolpath: the session's mesh (built during the update,
-/// beside the toolpath) copied into a Bevy mesh, and the toolpath's coloured lines.
+/// What the view does with a new wall and toolpath: the session's mesh (built during the update)
+/// copied into a Bevy mesh, and the toolpath's coloured lines as a gizmo.
 fn rebuild_mesh(app: &mut App) {
     let world = app.world_mut();
     let mesh = world
@@ -63,7 +63,10 @@ fn rebuild_mesh(app: &mut App) {
         .unwrap()
         .0
         .clone();
-    std::hint::black_box(toolpath_line(&path));
+    // As the view draws it: a retained gizmo line strip (which stores linear colours).
+    let mut lines = GizmoAsset::new();
+    lines.linestrip_gradient(toolpath_line(&path));
+    std::hint::black_box(lines);
 }
 
 fn bench(c: &mut Criterion) {

@@ -21,18 +21,68 @@ pub fn wall_mesh(b: WallBuffers) -> Mesh {
     .with_inserted_indices(Indices::U32(b.indices))
 }
 
-/// The spiral toolpath as a coloured line strip in world coordinates: blue at the foot to warm
-/// at the rim, so the climb of the spiral reads at a glance.
-pub fn toolpath_line(path: &clayloft_core::toolpath::Toolpath) -> Vec<(Vec3, Color)> {
+/// Steps of the toolpath's colour ramp: finer than an 8-bit colour step of the ramp.
+const RAMP_STEPS: usize = 1024;
+
+/// The toolpath's colour at height fraction `f` (0 at the foot, 1 at the rim): blue to warm, so
+/// the climb of the spiral reads at a glance.
+pub fn toolpath_color(f: f32) -> Color {
+    Color::srgb(0.25 + 0.7 * f, 0.55 + 0.2 * (1.0 - f), 1.0 - 0.6 * f)
+}
+
+/// The spiral toolpath as a coloured line strip in world coordinates ([`toolpath_color`] by
+/// height), point by point (straight into a gizmo, no list in between). The colours are linear,
+/// as a gizmo keeps them, taken from a table of the ramp: the sRGB-to-linear conversion (three
+/// powers per point, 230 000 for a 360 × 200 design) would otherwise cost more than the rest.
+pub fn toolpath_line(
+    path: &clayloft_core::toolpath::Toolpath,
+) -> impl ExactSizeIterator<Item = (Vec3, Color)> + '_ {
     let pts = &path.points;
     let top = pts.iter().map(|p| p.pos.z).fold(1.0_f64, f64::max);
-    pts.iter()
-        .map(|p| {
-            let f = (p.pos.z / top) as f32;
-            (
-                to_world(p.pos),
-                Color::srgb(0.25 + 0.7 * f, 0.55 + 0.2 * (1.0 - f), 1.0 - 0.6 * f),
-            )
-        })
-        .collect()
+    let ramp: Vec<Color> = (0..RAMP_STEPS)
+        .map(|i| Color::LinearRgba(toolpath_color(i as f32 / (RAMP_STEPS - 1) as f32).into()))
+        .collect();
+    let last = (RAMP_STEPS - 1) as f64;
+    pts.iter().map(move |p| {
+        let step = ((p.pos.z / top).clamp(0.0, 1.0) * last).round() as usize;
+        (to_world(p.pos), ramp[step])
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table's colours are the ramp's within a tenth of an 8-bit step, from the foot (blue)
+    /// to the rim (warm).
+    #[test]
+    fn the_toolpath_ramp_runs_from_blue_to_warm() {
+        use clayloft_core::toolpath::{PathPoint, Toolpath};
+        let points: Vec<PathPoint> = (0..=1000)
+            .map(|i| PathPoint {
+                pos: bevy::math::DVec3::new(0.0, 0.0, 0.1 * i as f64),
+                thickness: 1.0,
+                flow: 1.0,
+                speed: 20.0,
+            })
+            .collect();
+        let path = Toolpath {
+            points,
+            ..Toolpath::default()
+        };
+        let line: Vec<_> = toolpath_line(&path).collect();
+        for (p, (_, c)) in path.points.iter().zip(&line) {
+            let want = toolpath_color((p.pos.z / 100.0) as f32).to_srgba();
+            let got = c.to_srgba();
+            for (a, b) in [
+                (got.red, want.red),
+                (got.green, want.green),
+                (got.blue, want.blue),
+            ] {
+                assert!((a - b).abs() < 0.1 / 255.0 + 1e-6, "{got:?} {want:?}");
+            }
+        }
+        let (foot, rim) = (line[0].1.to_srgba(), line[1000].1.to_srgba());
+        assert!(foot.blue > foot.red && rim.red > rim.blue);
+    }
 }
