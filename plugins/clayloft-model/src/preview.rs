@@ -42,9 +42,12 @@ pub fn toolpath_line(
     let ramp: Vec<Color> = (0..RAMP_STEPS)
         .map(|i| Color::LinearRgba(toolpath_color(i as f32 / (RAMP_STEPS - 1) as f32).into()))
         .collect();
+    // The step nearest the point's height fraction: ⌊x + ½⌋ for x ≥ 0 (no call to `round`,
+    // which the baseline x86-64 target makes a library call).
     let last = (RAMP_STEPS - 1) as f64;
+    let per_mm = last / top;
     pts.iter().map(move |p| {
-        let step = ((p.pos.z / top).clamp(0.0, 1.0) * last).round() as usize;
+        let step = ((p.pos.z * per_mm).clamp(0.0, last) + 0.5) as usize;
         (to_world(p.pos), ramp[step])
     })
 }
