@@ -217,14 +217,23 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
             .map(|l| (l.top * 1e3, f64::INFINITY))
             .collect(),
     };
-    // Each layer's knock-down factor, once (not once per layer above it).
-    let knock_downs: Vec<f64> = layers
+    // Both factors are τ₀(age)/(ρ·g·h) times a constant of the loaded layer: √3 for plastic
+    // collapse, γ·E₀·e/(1.5·R·τ₀) for buckling (γ the layer's knock-down factor, E(age) =
+    // E₀·τ₀(age)/τ₀). So each layer fails by one mechanism whatever loads it, its constant is
+    // computed once, and a pair of layers costs one division.
+    let by_layer: Vec<(f64, Mechanism)> = layers
         .iter()
         .map(|l| {
-            if l.radius > 0.0 {
-                knock_down(l.radius, e)
+            let buckling = if l.radius > 0.0 {
+                knock_down(l.radius, e) * body.elastic_modulus * e
+                    / (1.5 * l.radius * body.yield_stress)
             } else {
-                0.0
+                f64::INFINITY
+            };
+            if buckling < 3f64.sqrt() {
+                (buckling, Mechanism::Buckling)
+            } else {
+                (3f64.sqrt(), Mechanism::PlasticCollapse)
             }
         })
         .collect();
@@ -235,18 +244,8 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
                 continue;
             }
             let age = done[j] - done[k];
-            let stress = rho_g * h;
-            let collapse = 3f64.sqrt() * body.yield_stress_at(age) / stress;
-            let buckling = if l.radius > 0.0 {
-                knock_downs[k] * body.elastic_modulus_at(age) * e / (1.5 * l.radius * stress)
-            } else {
-                f64::INFINITY
-            };
-            let (f, m) = if buckling < collapse {
-                (buckling, Mechanism::Buckling)
-            } else {
-                (collapse, Mechanism::PlasticCollapse)
-            };
+            let (c, m) = by_layer[k];
+            let f = c * body.yield_stress_at(age) / (rho_g * h);
             let own = &mut worst.layer_factors[k].1;
             *own = own.min(f);
             if f < worst.factor {
