@@ -144,23 +144,35 @@ pub fn assess(design: &Design, toolpath: &Toolpath) -> Result<Printability, Fiel
 fn layers_of(design: &Design, tp: &Toolpath) -> Vec<Layer> {
     let pts = &tp.points;
     let walls = design.shape.walls.max(1) as f64;
-    let mut out = Vec::with_capacity(tp.layer_starts.len());
+    let starts = &tp.layer_starts;
+    // Each layer's time, length and top (a sum along its points), the layers in parts on the
+    // machine's cores: the same sums in the same order as on one.
+    let sums = crate::parallel::map_ranges(starts.len(), 64, |r| {
+        r.map(|i| {
+            let (start, end) = (starts[i], starts.get(i + 1).copied().unwrap_or(pts.len()));
+            if end <= start {
+                return None;
+            }
+            let (mut duration, mut length, mut top) = (0.0, 0.0, f64::MIN);
+            for k in start.max(1)..end {
+                let seg = pts[k - 1].pos.distance(pts[k].pos);
+                duration += seg / pts[k].speed.max(1e-9);
+                length += seg;
+            }
+            for p in &pts[start..end] {
+                top = top.max(p.pos.z);
+            }
+            Some((duration, length, top))
+        })
+        .collect()
+    });
+    let mut out = Vec::with_capacity(starts.len());
     let mut bottom = 0.0;
-    for (i, &start) in tp.layer_starts.iter().enumerate() {
-        let end = tp.layer_starts.get(i + 1).copied().unwrap_or(pts.len());
-        if end <= start {
+    for (i, sum) in sums.into_iter().enumerate() {
+        let Some((duration, length, top)) = sum else {
             continue;
-        }
-        let (mut duration, mut length, mut top) = (0.0, 0.0, f64::MIN);
-        for k in start.max(1)..end {
-            let seg = pts[k - 1].pos.distance(pts[k].pos);
-            duration += seg / pts[k].speed.max(1e-9);
-            length += seg;
-        }
-        for p in &pts[start..end] {
-            top = top.max(p.pos.z);
-        }
-        let base = start < tp.base_points;
+        };
+        let base = starts[i] < tp.base_points;
         out.push(Layer {
             duration,
             bottom,
