@@ -208,14 +208,18 @@ mod tests {
         app
     }
 
+    /// [`headless`] on the default design.
+    fn headless_default_design() -> App {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs/petal-vase.toml");
+        headless(clayloft_core::load_design(&path).unwrap().design)
+    }
+
     /// Idle frames rebuild nothing: no recompute, no wall mesh, no toolpath lines, no control
     /// lines, and the design, the engine and the view settings are never marked changed.
     #[test]
     fn idle_frames_rebuild_nothing() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs/petal-vase.toml");
-        let design = clayloft_core::load_design(&path).unwrap().design;
-        let mut app = headless(design);
+        let mut app = headless_default_design();
         #[derive(Resource, Default, Debug)]
         struct Changes(u64);
         app.init_resource::<Changes>().add_systems(
@@ -309,10 +313,7 @@ mod tests {
     /// flags what the checker flags.
     #[test]
     fn the_replay_checks_the_path_in_the_background_while_shown() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/designs/petal-vase.toml");
-        let design = clayloft_core::load_design(&path).unwrap().design;
-        let mut app = headless(design);
+        let mut app = headless_default_design();
         for _ in 0..5 {
             app.update();
         }

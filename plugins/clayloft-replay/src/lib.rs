@@ -306,8 +306,11 @@ fn check_replay_path(
             .map_or(Err(TryRecvError::Disconnected), |r| r.try_recv());
         match result {
             Err(TryRecvError::Empty) => {}
-            // A check that stopped without a result (it cannot: it reads no input) flags nothing.
             Ok(_) | Err(TryRecvError::Disconnected) => {
+                if result.is_err() {
+                    // A panic in the checker (a bug: its input is a path the core made).
+                    error!("the replay's check of the path stopped without a result");
+                }
                 if *current {
                     path.events = result.unwrap_or_default();
                     path.checking = false;
