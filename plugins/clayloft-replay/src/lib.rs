@@ -446,10 +446,18 @@ fn grow_printed_part(
         return;
     }
     source.rows_shown = rows;
-    let quads = rows.saturating_sub(1) * source.buffers.indices_per_row;
-    let mut b = (*source.buffers).clone();
-    b.indices.truncate(quads);
-    let _ = meshes.insert(part.0.id(), wall_mesh(b));
+    // Every vertex (the sheets' rows interleave in the index list, not in the vertex list) and
+    // the triangles of the rows printed.
+    let wall = &*source.buffers;
+    let quads = (rows.saturating_sub(1) * wall.indices_per_row).min(wall.indices.len());
+    let printed = WallBuffers {
+        positions: wall.positions.clone(),
+        normals: wall.normals.clone(),
+        colors: wall.colors.clone(),
+        indices: wall.indices[..quads].to_vec(),
+        ..WallBuffers::default()
+    };
+    let _ = meshes.insert(part.0.id(), wall_mesh(printed));
 }
 
 fn swap_wall_for_printed_part(
