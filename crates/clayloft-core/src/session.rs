@@ -215,7 +215,7 @@ impl Update {
 }
 
 /// The stages after the shape: the texture's displacement table, the corrected surface, the base
-/// fill and the toolpath.
+/// fill, the beads, the toolpath, its verdict and the wall's mesh for a view.
 #[derive(Debug, Clone, Default)]
 struct LaterStages {
     /// The texture's displacements on the section grid (no shape input: kept while shaping).
@@ -285,7 +285,8 @@ pub struct Session {
     sections: Vec<Stage<SectionKey, Section>>,
     /// Bumped whenever any section is recomputed or the section count changes.
     sections_revision: u64,
-    /// The stages after the shape, lofted or sliced: texture, surface, base, toolpath.
+    /// The stages after the shape, lofted or sliced: texture, surface, base, beads, toolpath,
+    /// verdict, view mesh.
     later: LaterStages,
     /// A design from a mesh: the mesh read and placed, its slices, the wall sections from them.
     mesh: Stage<MeshKey, Arc<crate::stl::Mesh>>,
@@ -632,7 +633,8 @@ impl Session {
 
 /// The stages every design shares once its shaped sections are known: the texture's
 /// displacements, the corrected surface (its key holds the revisions `inputs` of what the
-/// sections came from), the base fill and the toolpath.
+/// sections came from), the base fill, the beads, the toolpath, its verdict and (`wall_view`)
+/// the wall's mesh for a view.
 #[allow(clippy::too_many_arguments)]
 fn finish_stages(
     later: &mut LaterStages,
@@ -678,7 +680,7 @@ fn finish_stages(
         finish_sections(design, grid, shaped(), plan_findings.to_vec(), disp).map(Arc::new)
     })?;
 
-    // 5. Toolpath.
+    // 5.–6. Base fill, beads and toolpath.
     let surface = later
         .surface
         .get()
@@ -720,7 +722,7 @@ fn finish_stages(
         build_toolpath_on(design, &surface, fills, beads).map(Arc::new)
     })?;
 
-    // 6. Whether the wet wall stands while it is printed, and 7. the wall's mesh for a view
+    // 7. Whether the wet wall stands while it is printed, and 8. the wall's mesh for a view
     // (after the beads: a wall of several shows its inner bead). Each runs on one core, so they
     // run side by side. (The mesh built beside the toolpath measured no faster: the toolpath's
     // stages use both cores already.)

@@ -60,8 +60,8 @@ pub struct Vessel;
 #[derive(Component, Debug, Clone)]
 pub struct VesselSurface(pub Arc<Surface>);
 
-/// The wall's mesh for the view (the core's [`clayloft_core::view_mesh`], built by the session
-/// beside the toolpath), on the vessel entity: shared by the 3D view and the replay.
+/// The wall's mesh for the view (the core's [`clayloft_core::view_mesh`], a stage of the
+/// session), on the vessel entity: shared by the 3D view and the replay.
 #[derive(Component, Debug, Clone)]
 pub struct VesselMesh(pub Arc<clayloft_core::view_mesh::WallBuffers>);
 

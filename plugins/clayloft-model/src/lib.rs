@@ -7,8 +7,9 @@
 //! - one section entity per layer boundary ([`SectionIndex`], [`ShapedSection`]);
 //! - one entity per editable point ([`EditHandle`]): contour points and radii, control-line points;
 //! - one entity per control line ([`ControlLine`]) with its drawn curve;
-//! - the vessel ([`Vessel`]) holding the corrected, textured [`VesselSurface`];
-//! - the toolpath ([`ToolpathPath`]).
+//! - the vessel ([`Vessel`]) holding the corrected, textured [`VesselSurface`] and its mesh for
+//!   the view ([`VesselMesh`]);
+//! - the toolpath ([`ToolpathPath`]) and whether the wall stands ([`ToolpathPrintability`]).
 //!
 //! The core's incremental engine ([`clayloft_core::Session`], held in [`Engine`]) decides what an
 //! edit must redo: a local vertical control line recomputes only the sections in its span, a
