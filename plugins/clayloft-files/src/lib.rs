@@ -10,13 +10,12 @@
 //! removes it.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::Duration;
 
 use bevy::prelude::*;
 use clayloft_core::atomic::write_atomically;
 use clayloft_core::{Design, PrintJob};
+use clayloft_model::background::{Background, Stopped};
 use clayloft_model::{DesignDoc, Engine, ModelSystems};
 
 /// What the user asked the files plugin to do.
@@ -251,7 +250,7 @@ type ExportResult = Result<String, String>;
 /// recomputed, and the UI never waits for the file).
 #[derive(Resource, Default)]
 pub struct Exports {
-    running: Vec<(PathBuf, Mutex<Receiver<ExportResult>>)>,
+    running: Vec<(PathBuf, Background<ExportResult>)>,
 }
 
 impl Exports {
@@ -280,12 +279,9 @@ fn start_export(
         Ok(j) => j,
         Err(e) => return status.err(e),
     };
-    let (tx, rx) = std::sync::mpsc::channel();
     let (design, file) = (design.clone(), path.to_path_buf());
-    std::thread::spawn(move || {
-        let _ = tx.send(write(&design, &job, &file));
-    });
-    exports.running.push((path.to_path_buf(), Mutex::new(rx)));
+    let export = Background::start(move || write(&design, &job, &file));
+    exports.running.push((path.to_path_buf(), export));
     status.ok(format!("writing {} …", path.display()));
 }
 
@@ -298,29 +294,26 @@ fn poll_exports(
     if exports.running.is_empty() {
         return;
     }
-    exports.running.retain_mut(|(path, rx)| {
-        match rx
-            .get_mut()
-            .map_or(Err(TryRecvError::Disconnected), |r| r.try_recv())
-        {
-            Ok(Ok(m)) => {
+    exports
+        .running
+        .retain_mut(|(path, export)| match export.poll() {
+            None => true,
+            Some(Ok(Ok(m))) => {
                 status.ok(m);
                 false
             }
-            Ok(Err(e)) => {
+            Some(Ok(Err(e))) => {
                 status.err(e);
                 false
             }
-            Err(TryRecvError::Empty) => true,
-            Err(TryRecvError::Disconnected) => {
+            Some(Err(Stopped)) => {
                 status.err(format!(
                     "{}: the export stopped unexpectedly",
                     path.display()
                 ));
                 false
             }
-        }
-    });
+        });
     if !exports.running.is_empty()
         && let Some(mut redraw) = redraw
     {

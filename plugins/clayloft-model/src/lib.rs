@@ -17,6 +17,7 @@
 //! here copy its outputs into components; the math, the control-line curves and the handle
 //! positions are the core library's ([`clayloft_core`]); nothing here repeats it.
 
+pub mod background;
 pub mod components;
 pub mod coords;
 pub mod document;

@@ -9,13 +9,13 @@
 
 pub mod timeline;
 
-use std::sync::mpsc::{Receiver, TryRecvError};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bevy::picking::Pickable;
 use bevy::prelude::*;
 use clayloft_core::check::{Limits, PathEvent, check_path};
 use clayloft_core::view_mesh::WallBuffers;
+use clayloft_model::background::Background;
 use clayloft_model::coords::to_world;
 use clayloft_model::preview::wall_mesh;
 use clayloft_model::*;
@@ -118,7 +118,7 @@ struct ReplayCheck {
     /// The path to check next (it changed since the running check started).
     wanted: Option<(Arc<clayloft_core::toolpath::Toolpath>, Limits)>,
     /// The running check, and whether it is of the current path.
-    running: Option<(Mutex<Receiver<Vec<PathEvent>>>, bool)>,
+    running: Option<(Background<Vec<PathEvent>>, bool)>,
 }
 
 /// Marker of the nozzle's root entity (at the tip).
@@ -300,35 +300,26 @@ fn check_replay_path(
     mut check: ResMut<ReplayCheck>,
     redraw: Option<ResMut<Messages<bevy::window::RequestRedraw>>>,
 ) {
-    if let Some((rx, current)) = &mut check.running {
-        let result = rx
-            .get_mut()
-            .map_or(Err(TryRecvError::Disconnected), |r| r.try_recv());
-        match result {
-            Err(TryRecvError::Empty) => {}
-            Ok(_) | Err(TryRecvError::Disconnected) => {
-                if result.is_err() {
-                    // A panic in the checker (a bug: its input is a path the core made).
-                    error!("the replay's check of the path stopped without a result");
-                }
-                if *current {
-                    path.events = result.unwrap_or_default();
-                    path.checking = false;
-                    path.passed = path.events.partition_point(|e| e.line <= path.index);
-                }
-                check.running = None;
-            }
+    if let Some((job, current)) = &mut check.running
+        && let Some(result) = job.poll()
+    {
+        if result.is_err() {
+            // A panic in the checker (a bug: its input is a path the core made).
+            error!("the replay's check of the path stopped without a result");
         }
+        if *current {
+            path.events = result.unwrap_or_default();
+            path.checking = false;
+            path.passed = path.events.partition_point(|e| e.line <= path.index);
+        }
+        check.running = None;
     }
     if check.running.is_none()
         && replay.active
         && let Some((toolpath, limits)) = check.wanted.take()
     {
-        let (tx, rx) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            let _ = tx.send(flagged_points(&toolpath, &limits));
-        });
-        check.running = Some((Mutex::new(rx), true));
+        let job = Background::start(move || flagged_points(&toolpath, &limits));
+        check.running = Some((job, true));
     }
     if check.running.is_some()
         && let Some(mut redraw) = redraw
