@@ -13,7 +13,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use clayloft_core::check::{Limits, check_gcode};
+// The batch commands keep the helper threads spinning from start to end: their stages follow
+// each other closely (see `clayloft_core::parallel`).
 use clayloft_core::gcode::{JobSummary, format_duration, summarize, write_gcode_summarized};
+use clayloft_core::parallel::awake;
 use clayloft_core::stl::{job_mesh, write_ascii_stl, write_binary_stl};
 use clayloft_core::{LoadedDesign, PrintJob, load_design};
 
@@ -161,16 +164,16 @@ fn main() -> ExitCode {
             design,
             out,
             printer,
-        }) => gcode(&design, &out, printer.as_deref()),
+        }) => awake(|| gcode(&design, &out, printer.as_deref())),
         Some(Command::Stl {
             design,
             out,
             ascii,
             printer,
-        }) => stl(&design, &out, ascii, printer.as_deref()),
+        }) => awake(|| stl(&design, &out, ascii, printer.as_deref())),
         Some(Command::Printers) => printers(),
         Some(Command::ClayBodies) => clay_bodies(),
-        Some(Command::Check { gcode, design }) => check(&gcode, design.as_deref()),
+        Some(Command::Check { gcode, design }) => awake(|| check(&gcode, design.as_deref())),
         Some(Command::Print {
             gcode,
             port,

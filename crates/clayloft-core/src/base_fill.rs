@@ -338,21 +338,24 @@ fn grow_on(
     two_threads: bool,
 ) -> Result<(), FillError> {
     let (send, receive) = std::sync::mpsc::channel::<Polyline<f64>>();
-    let offset_all =
-        move || -> Vec<_> { receive.into_iter().map(|pl| offset(&pl, 0.5 * w)).collect() };
-    let middles = if two_threads && levels > 1 {
-        std::thread::scope(|scope| {
-            let worker = scope.spawn(offset_all);
-            let grown = grow_rings(root, exact, w, levels, &send);
-            drop(send);
-            let middles = crate::parallel::join(worker);
-            grown.map(|()| middles)
-        })?
-    } else {
-        grow_rings(root, exact, w, levels, &send)?;
-        drop(send);
-        offset_all()
+    // On a helper this waits for each ring by spinning (a ring takes tens of microseconds, a
+    // sleeping thread as long to wake); run after the rings, it finds them all sent.
+    let offset_all = move || -> Vec<_> {
+        let mut out = Vec::new();
+        loop {
+            match receive.try_recv() {
+                Ok(pl) => out.push(offset(&pl, 0.5 * w)),
+                Err(std::sync::mpsc::TryRecvError::Empty) => std::hint::spin_loop(),
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => return out,
+            }
+        }
     };
+    let (middles, grown) = crate::parallel::both(two_threads && levels > 1, offset_all, || {
+        let grown = grow_rings(root, exact, w, levels, &send);
+        drop(send);
+        grown
+    });
+    grown?;
     add_middles(root, &mut middles.into_iter(), w, levels)
 }
 

@@ -336,19 +336,18 @@ fn write_program_indexed(
     let p = &design.printer;
     let tp = &job.toolpath;
     // The motion planner (the time estimate) and the thumbnails are independent: one core each.
-    let (summary, thumbnails) = std::thread::scope(|scope| {
-        let thumbnails = p.thumbnail.then(|| {
-            scope.spawn(|| {
+    let (thumbnails, summary) = crate::parallel::both(
+        p.thumbnail,
+        || {
+            p.thumbnail.then(|| {
                 // Thinned to what a thumbnail draws: no copy of the whole path.
                 let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
                 let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
                 crate::thumbnail::header_blocks(&points)
             })
-        });
-        let summary = summarize(design, job);
-        let thumbnails = thumbnails.map(|h| crate::parallel::join(h));
-        (summary, thumbnails)
-    });
+        },
+        || summarize(design, job),
+    );
     let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
         crate::templates::fill(t, &values)
@@ -626,28 +625,23 @@ impl<'a> BodyWriter<'a> {
                 .map(|s| s..(s + chunk).min(n))
                 .collect();
             let (last, others) = ranges.split_last().expect("a chunk or more");
-            let parts: Vec<(Vec<u8>, Vec<u32>)> = if n < 4096 {
-                let mut parts = Vec::with_capacity(ranges.len());
-                for r in others {
-                    parts.push(self.format(r.clone(), state, want_index));
-                    state = self.advance(state, r.clone());
+            let parts: Vec<(Vec<u8>, Vec<u32>)> = match others {
+                // Two chunks: the first on a helper while this thread adds up its sums for the
+                // second, then formats the second.
+                [first] => {
+                    let first_state = state;
+                    let (a, b) = crate::parallel::both(
+                        n >= 4096,
+                        || self.format(first.clone(), first_state, want_index),
+                        || {
+                            state = self.advance(state, first.clone());
+                            self.format(last.clone(), state, want_index)
+                        },
+                    );
+                    vec![a, b]
                 }
-                parts.push(self.format(last.clone(), state, want_index));
-                parts
-            } else {
-                std::thread::scope(|scope| {
-                    let mut handles = Vec::with_capacity(others.len());
-                    for r in others {
-                        let (st, r2) = (state, r.clone());
-                        handles.push(scope.spawn(move || self.format(r2, st, want_index)));
-                        state = self.advance(state, r.clone());
-                    }
-                    let tail = self.format(last.clone(), state, want_index);
-                    let mut parts: Vec<_> =
-                        handles.into_iter().map(crate::parallel::join).collect();
-                    parts.push(tail);
-                    parts
-                })
+                [] => vec![self.format(last.clone(), state, want_index)],
+                _ => unreachable!("at most two chunks a round"),
             };
             if last.end < n {
                 state = self.advance(state, last.clone());

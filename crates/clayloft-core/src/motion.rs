@@ -102,10 +102,10 @@ fn plan_time_in(
     // entry2[i]: squared speed entering move i; entry2[n] = 0 (the job ends at rest).
     let mut entry2 = vec![0.0; n + 1];
     let parts = crate::parallel::ranges(n, serial_below);
-    std::thread::scope(|scope| {
+    {
         let (mut len, mut speed, mut entry2) = (&mut len[..], &mut speed[..], &mut entry2[..n]);
-        let mut handles = Vec::new();
-        for (k, range) in parts.iter().enumerate() {
+        let mut jobs = Vec::with_capacity(parts.len());
+        for range in &parts {
             let (l, rest_l) = std::mem::take(&mut len).split_at_mut(range.len());
             let (s, rest_s) = std::mem::take(&mut speed).split_at_mut(range.len());
             let (e, rest_e) = std::mem::take(&mut entry2).split_at_mut(range.len());
@@ -116,17 +116,10 @@ fn plan_time_in(
                 entry2: e,
             };
             let range = range.clone();
-            if k + 1 == parts.len() {
-                // The last part on the calling thread: one thread fewer to start.
-                entry_limits(start, moves, range, legs, a, deviation);
-            } else {
-                handles.push(
-                    scope.spawn(move || entry_limits(start, moves, range, legs, a, deviation)),
-                );
-            }
+            jobs.push(move || entry_limits(start, moves, range, legs, a, deviation));
         }
-        handles.into_iter().for_each(crate::parallel::join);
-    });
+        crate::parallel::run_parts(jobs);
+    }
     // Backward pass: every move can still slow down to the next entry speed.
     for i in (0..n).rev() {
         let reach = entry2[i + 1] + two_a * len[i];

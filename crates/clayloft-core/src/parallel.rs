@@ -1,8 +1,22 @@
-//! The helpers every stage that uses both cores shares (scoped threads from `std`; the work is
-//! split by each stage into contiguous ranges, so results come back in order and do not depend
-//! on the number of cores).
+//! The helpers every stage that uses both cores shares. The work is split by each stage into
+//! contiguous ranges, so results come back in order and do not depend on the number of cores or
+//! on which thread ran which part.
+//!
+//! **Helper threads.** Parts run on the calling thread and on `cores − 1` helper threads that
+//! live as long as the process. A thread started for each part cost about 50 µs here, and a
+//! sleeping thread about as much to wake (a virtual machine's idle core is halted): more than
+//! many parts take. So a helper that has finished a part keeps spinning for [`LINGER`] before it
+//! sleeps, and inside [`awake`] (a session update, a whole command) it spins until the end: a
+//! part handed over starts within a microsecond. A part is handed to a free helper or, when
+//! none is free (a part started from a part, or two threads at once), run on the calling thread:
+//! the cores are busy then anyway.
 
+use std::any::Any;
 use std::ops::Range;
+use std::panic::AssertUnwindSafe;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Mutex, OnceLock};
+use std::time::{Duration, Instant};
 
 /// Threads worth starting for independent work: the machine's cores (1 if unknown), asked once
 /// (on Linux the answer reads the cgroup files, a few system calls each time).
@@ -16,6 +30,214 @@ pub fn join<T>(handle: std::thread::ScopedJoinHandle<'_, T>) -> T {
     handle
         .join()
         .unwrap_or_else(|e| std::panic::resume_unwind(e))
+}
+
+/// How long a helper keeps spinning after a part outside [`awake`] before it sleeps.
+const LINGER: Duration = Duration::from_micros(200);
+
+/// A part handed to a helper, its lifetime erased (see [`Helper::hand`]).
+type Part = Box<dyn FnOnce() + Send + 'static>;
+
+/// One helper thread and the part it is given.
+struct Helper {
+    /// Taken by the thread that hands it a part, until that part is done.
+    claimed: AtomicBool,
+    /// Set once a part waits in `part`, so that the spinning helper need not lock.
+    posted: AtomicBool,
+    part: Mutex<Option<Part>>,
+    /// Set by the helper when the part has run.
+    done: AtomicBool,
+    /// The part's panic, to go on in the thread that handed it over.
+    panic: Mutex<Option<Box<dyn Any + Send>>>,
+    thread: OnceLock<std::thread::Thread>,
+}
+
+/// The helpers, and how many [`awake`] scopes are open.
+struct Pool {
+    helpers: Vec<&'static Helper>,
+    awake: AtomicUsize,
+}
+
+fn pool() -> &'static Pool {
+    static POOL: OnceLock<Pool> = OnceLock::new();
+    POOL.get_or_init(|| {
+        let mut helpers = Vec::new();
+        for k in 1..cores() {
+            let helper: &'static Helper = Box::leak(Box::new(Helper {
+                claimed: AtomicBool::new(false),
+                posted: AtomicBool::new(false),
+                part: Mutex::new(None),
+                done: AtomicBool::new(false),
+                panic: Mutex::new(None),
+                thread: OnceLock::new(),
+            }));
+            let started = std::thread::Builder::new()
+                .name(format!("clayloft helper {k}"))
+                .spawn(move || helper.serve());
+            // Without a helper the parts run on the calling thread.
+            if let Ok(handle) = started {
+                let _ = helper.thread.set(handle.thread().clone());
+                helpers.push(helper);
+            }
+        }
+        Pool {
+            helpers,
+            awake: AtomicUsize::new(0),
+        }
+    })
+}
+
+impl Helper {
+    /// The helper thread: runs the parts handed to it; spins while an [`awake`] scope is open
+    /// or for [`LINGER`] after a part, else sleeps until the next part.
+    fn serve(&'static self) {
+        let mut last = Instant::now();
+        let mut spins = 0u32;
+        loop {
+            if self.posted.swap(false, Ordering::Acquire) {
+                let part = self.part.lock().unwrap_or_else(|e| e.into_inner()).take();
+                if let Some(part) = part
+                    && let Err(panic) = std::panic::catch_unwind(AssertUnwindSafe(part))
+                {
+                    *self.panic.lock().unwrap_or_else(|e| e.into_inner()) = Some(panic);
+                }
+                self.done.store(true, Ordering::Release);
+                last = Instant::now();
+                continue;
+            }
+            spins = spins.wrapping_add(1);
+            if pool().awake.load(Ordering::Relaxed) > 0
+                || spins % 64 != 0
+                || last.elapsed() < LINGER
+            {
+                std::hint::spin_loop();
+            } else {
+                std::thread::park();
+                last = Instant::now();
+            }
+        }
+    }
+
+    /// A free helper, claimed for one part; none when every helper is busy.
+    fn claim() -> Option<&'static Helper> {
+        pool().helpers.iter().copied().find(|h| {
+            h.claimed
+                .compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed)
+                .is_ok()
+        })
+    }
+
+    /// Hands `part` to this (claimed) helper. The part may borrow from the caller's stack: the
+    /// returned [`Handed`] waits for it to finish when dropped, on unwinding too, so that nothing
+    /// it borrows goes away while it runs (the guarantee `std::thread::scope` gives).
+    fn hand<'a>(&'static self, part: Box<dyn FnOnce() + Send + 'a>) -> Handed {
+        // SAFETY: the part only runs before `Handed::wait` returns, and `Handed` (which cannot
+        // be leaked by the callers in this module) waits in its `Drop`, so the borrows of `'a`
+        // outlive the part's run.
+        let part: Part =
+            unsafe { std::mem::transmute::<Box<dyn FnOnce() + Send + 'a>, Part>(part) };
+        *self.part.lock().unwrap_or_else(|e| e.into_inner()) = Some(part);
+        self.done.store(false, Ordering::Relaxed);
+        self.posted.store(true, Ordering::Release);
+        if let Some(thread) = self.thread.get() {
+            thread.unpark();
+        }
+        Handed {
+            helper: self,
+            waited: false,
+        }
+    }
+}
+
+/// A part handed to a helper; waiting for it frees the helper and passes its panic on.
+struct Handed {
+    helper: &'static Helper,
+    waited: bool,
+}
+
+impl Handed {
+    fn finish(&mut self) -> Option<Box<dyn Any + Send>> {
+        let started = Instant::now();
+        let mut spins = 0u32;
+        while !self.helper.done.load(Ordering::Acquire) {
+            spins = spins.wrapping_add(1);
+            // Spin while the part is short; then give the core to other threads.
+            if spins % 64 == 0 && started.elapsed() > Duration::from_micros(100) {
+                std::thread::yield_now();
+            } else {
+                std::hint::spin_loop();
+            }
+        }
+        self.waited = true;
+        let panic = self
+            .helper
+            .panic
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        self.helper.claimed.store(false, Ordering::Release);
+        panic
+    }
+
+    /// Waits for the part; its panic goes on here.
+    fn wait(mut self) {
+        if let Some(panic) = self.finish() {
+            std::panic::resume_unwind(panic);
+        }
+    }
+}
+
+impl Drop for Handed {
+    fn drop(&mut self) {
+        if !self.waited {
+            // Unwinding from the caller's own part: wait, and let the caller's panic go on.
+            let _ = self.finish();
+        }
+    }
+}
+
+/// Runs `f` with the helpers spinning throughout (a burst of parallel stages: a session update,
+/// a whole command), so that handing a part over costs no wake-up. Scopes may nest and overlap.
+pub fn awake<R>(f: impl FnOnce() -> R) -> R {
+    struct Open(&'static Pool);
+    impl Drop for Open {
+        fn drop(&mut self) {
+            self.0.awake.fetch_sub(1, Ordering::Relaxed);
+        }
+    }
+    let pool = pool();
+    pool.awake.fetch_add(1, Ordering::Relaxed);
+    let _open = Open(pool);
+    for h in &pool.helpers {
+        if let Some(thread) = h.thread.get() {
+            thread.unpark();
+        }
+    }
+    f()
+}
+
+/// Runs every part, the last on this thread and the others on free helpers (or on this thread,
+/// in order, when none is free); the results in the parts' order.
+pub fn run_parts<R: Send, F: FnOnce() -> R + Send>(parts: Vec<F>) -> Vec<R> {
+    let mut results: Vec<Option<R>> = parts.iter().map(|_| None).collect();
+    let mut here = Vec::new();
+    let mut handed = Vec::new();
+    let count = parts.len();
+    for ((k, part), slot) in parts.into_iter().enumerate().zip(results.iter_mut()) {
+        let helper = if k + 1 < count { Helper::claim() } else { None };
+        match helper {
+            Some(h) => handed.push(h.hand(Box::new(move || *slot = Some(part())))),
+            None => here.push((part, slot)),
+        }
+    }
+    for (part, slot) in here {
+        *slot = Some(part());
+    }
+    handed.into_iter().for_each(Handed::wait);
+    results
+        .into_iter()
+        .map(|r| r.expect("every part ran"))
+        .collect()
 }
 
 /// `0..len` cut into one contiguous range per core, or a single range when `len` is below
@@ -43,38 +265,29 @@ pub fn map_ranges<R: Send>(
         return f(0..len);
     }
     let f = &f;
-    // The last part runs on the calling thread: one thread fewer to start.
-    let (last, others) = parts.split_last().expect("two parts or more");
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = others
-            .iter()
-            .map(|r| {
-                let r = r.clone();
-                scope.spawn(move || f(r))
-            })
-            .collect();
-        let tail = f(last.clone());
-        let mut out: Vec<R> = handles.into_iter().flat_map(join).collect();
-        out.extend(tail);
-        out
-    })
+    run_parts(parts.into_iter().map(|r| move || f(r)).collect())
+        .into_iter()
+        .flatten()
+        .collect()
 }
 
-/// `a()` and `b()`, `a` on a second thread when `beside` (else both on this one, `a` first).
+/// `a()` and `b()`, `a` on a helper when `beside` and one is free (else on this thread after
+/// `b`: a part that waits on `b`'s results may be given as `a`).
 pub fn both<A: Send, B>(
     beside: bool,
     a: impl FnOnce() -> A + Send,
     b: impl FnOnce() -> B,
 ) -> (A, B) {
-    if !beside {
-        let a = a();
-        return (a, b());
-    }
-    std::thread::scope(|scope| {
-        let handle = scope.spawn(a);
+    let mut out_a = None;
+    let helper = if beside { Helper::claim() } else { None };
+    let Some(helper) = helper else {
         let b = b();
-        (join(handle), b)
-    })
+        return (a(), b);
+    };
+    let handed = helper.hand(Box::new(|| out_a = Some(a())));
+    let b = b();
+    handed.wait();
+    (out_a.expect("the helper ran a"), b)
 }
 
 /// `f(offset, part)` on contiguous parts of `items`, one per core (`offset`: the index of the
@@ -90,21 +303,13 @@ pub fn for_each_part<T: Send>(
     }
     let f = &f;
     let chunk = parts[0].len();
-    std::thread::scope(|scope| {
-        let mut chunks: Vec<(usize, &mut [T])> = items
+    run_parts(
+        items
             .chunks_mut(chunk)
             .enumerate()
-            .map(|(j, part)| (j * chunk, part))
-            .collect();
-        // The last part runs on the calling thread: one thread fewer to start.
-        let (offset, last) = chunks.pop().expect("two parts or more");
-        let handles: Vec<_> = chunks
-            .into_iter()
-            .map(|(offset, part)| scope.spawn(move || f(offset, part)))
-            .collect();
-        f(offset, last);
-        handles.into_iter().for_each(join);
-    })
+            .map(|(j, part)| move || f(j * chunk, part))
+            .collect(),
+    );
 }
 
 #[cfg(test)]
@@ -125,6 +330,70 @@ mod tests {
                 });
                 assert_eq!(v, (0..len).collect::<Vec<_>>());
             }
+        }
+    }
+
+    /// Parts handed to the helpers: results in order whoever runs them, parts started from
+    /// parts (run where they are, the helpers being busy), two threads asking at once, inside
+    /// and outside [`awake`].
+    #[test]
+    fn parts_give_the_same_results_from_any_thread() {
+        let sum = |r: Range<usize>| -> Vec<u64> { vec![r.map(|i| i as u64 * i as u64).sum()] };
+        let expected: u64 = (0..10_000u64).map(|i| i * i).sum();
+        let total = |parts: Vec<u64>| parts.into_iter().sum::<u64>();
+        assert_eq!(total(map_ranges(10_000, 0, sum)), expected);
+        awake(|| {
+            std::thread::scope(|s| {
+                let other = s.spawn(|| total(map_ranges(10_000, 0, sum)));
+                for _ in 0..50 {
+                    let (a, b) = both(
+                        true,
+                        || total(map_ranges(10_000, 0, sum)),
+                        || total(map_ranges(10_000, 0, sum)),
+                    );
+                    assert_eq!((a, b), (expected, expected));
+                }
+                assert_eq!(join(other), expected);
+            })
+        });
+    }
+
+    /// A panic in a part on a helper goes on in the caller, and the helper serves again.
+    #[test]
+    fn a_panic_in_a_helper_goes_on_in_the_caller() {
+        for _ in 0..3 {
+            let caught = std::panic::catch_unwind(|| {
+                run_parts(vec![
+                    Box::new(|| -> u32 { panic!("part 0") }) as Box<dyn FnOnce() -> u32 + Send>,
+                    Box::new(|| 1),
+                ])
+            });
+            assert!(caught.is_err());
+        }
+        assert_eq!(run_parts(vec![|| 1, || 2, || 3]), vec![1, 2, 3]);
+    }
+
+    /// A part that waits for what the calling thread's part makes (the base fill's middle
+    /// rings): on a helper it runs beside it, else after it; it never waits forever.
+    #[test]
+    fn a_part_given_as_a_may_wait_for_b() {
+        for beside in [false, true] {
+            let (send, receive) = std::sync::mpsc::channel::<u32>();
+            let (got, ()) = both(
+                beside,
+                move || {
+                    let mut got = Vec::new();
+                    loop {
+                        match receive.try_recv() {
+                            Ok(x) => got.push(x),
+                            Err(std::sync::mpsc::TryRecvError::Empty) => std::hint::spin_loop(),
+                            Err(std::sync::mpsc::TryRecvError::Disconnected) => return got,
+                        }
+                    }
+                },
+                move || (0..100).for_each(|x| send.send(x).unwrap()),
+            );
+            assert_eq!(got, (0..100).collect::<Vec<_>>());
         }
     }
 }

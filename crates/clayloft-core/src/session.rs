@@ -323,7 +323,7 @@ impl Session {
             Err(_) => design,
         };
         let result = match &wet {
-            Ok(_) => self.update_stages(design),
+            Ok(_) => crate::parallel::awake(|| self.update_stages(design)),
             Err(e) => Err(e.clone()),
         };
         match &result {

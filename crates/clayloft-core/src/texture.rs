@@ -135,18 +135,14 @@ pub fn apply_displacements(
         }
         return events;
     }
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = work
-            .map(|((cols, part), (left, right))| {
-                scope.spawn(move || {
-                    texture_columns(cols, part, &left, &right, disp, tan_limit, enforce)
-                })
-            })
-            .collect();
-        for h in handles {
-            events.extend(crate::parallel::join(h));
-        }
-    });
+    for part in crate::parallel::run_parts(
+        work.map(|((cols, part), (left, right))| {
+            move || texture_columns(cols, part, &left, &right, disp, tan_limit, enforce)
+        })
+        .collect(),
+    ) {
+        events.extend(part);
+    }
     events
 }
 

@@ -504,16 +504,15 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         }
         let chunk = n.div_ceil(threads);
         let share = budget / threads;
-        std::thread::scope(|scope| {
-            let parts: Vec<_> = (0..n)
+        crate::parallel::run_parts(
+            (0..n)
                 .step_by(chunk)
-                .map(|start| scope.spawn(move || self.range(start..(start + chunk).min(n), share)))
-                .collect();
-            parts
-                .into_iter()
-                .flat_map(|h| crate::parallel::join(h))
-                .collect()
-        })
+                .map(|start| move || self.range(start..(start + chunk).min(n), share))
+                .collect(),
+        )
+        .into_iter()
+        .flatten()
+        .collect()
     }
 
     /// Points `range`, with `budget` candidate chords to examine in all; once it is spent the

@@ -57,17 +57,7 @@ fn parse_moves_in(text: &str, part_bytes: usize) -> Result<(Vec<Move>, DVec3), G
     let read: Vec<Part> = if texts.len() == 1 {
         vec![read_part(text)]
     } else {
-        std::thread::scope(|scope| {
-            let (last, others) = texts.split_last().expect("one part or more");
-            let handles: Vec<_> = others
-                .iter()
-                .map(|&t| scope.spawn(move || read_part(t)))
-                .collect();
-            let last = read_part(last);
-            let mut read: Vec<Part> = handles.into_iter().map(crate::parallel::join).collect();
-            read.push(last);
-            read
-        })
+        crate::parallel::run_parts(texts.iter().map(|&t| move || read_part(t)).collect())
     };
     let mut state = State::default();
     let mut moves = Vec::with_capacity(read.iter().map(|p| p.moves.len()).sum());
