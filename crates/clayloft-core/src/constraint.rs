@@ -31,6 +31,175 @@ pub fn clamp_overhang(
     tan_limit: f64,
     enforce: bool,
 ) -> Vec<PointEvent> {
+    let start = from.max(1);
+    let n = sections.first().map_or(0, |s| s.points.len());
+    let rows = sections.len();
+    if start < rows
+        && (rows - start) * n >= PARALLEL_POINTS
+        && sections.iter().all(|s| s.points.len() == n)
+    {
+        let parts = crate::parallel::ranges(n, 2 * MIN_PART_COLUMNS);
+        if parts.len() > 1
+            && let Some(events) = clamp_by_columns(sections, start, &parts, tan_limit, enforce)
+        {
+            return events;
+        }
+    }
+    clamp_by_rows(sections, from, tan_limit, enforce)
+}
+
+/// Points below which [`clamp_overhang`] runs on one core.
+const PARALLEL_POINTS: usize = 20_000;
+
+/// Fewest columns a core takes in [`clamp_overhang`].
+const MIN_PART_COLUMNS: usize = 64;
+
+/// One core's columns in [`clamp_by_columns`]: each section's points there, and the first and
+/// last of them as each section is finished (for the cores on either side).
+struct ColumnPart<'a> {
+    columns: std::ops::Range<usize>,
+    rows: Vec<&'a mut [glam::DVec3]>,
+}
+
+/// [`clamp_by_rows`] with the columns cut into one contiguous part per core, all running at
+/// once, layer by layer: a part clamps section k once the parts on either side have finished
+/// section k − 1 (the normals at its edge columns need their neighbours' points), so the parts
+/// move up together, at most one section apart. Every point gets the arithmetic of the one-core
+/// clamp, and the events come back in its order. `None` when the cores are not free.
+fn clamp_by_columns(
+    sections: &mut [Section],
+    start: usize,
+    parts: &[std::ops::Range<usize>],
+    tan_limit: f64,
+    enforce: bool,
+) -> Option<Vec<PointEvent>> {
+    use std::sync::OnceLock;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let count = parts.len();
+    let rows = sections.len() - (start - 1);
+    let mut split: Vec<ColumnPart> = parts
+        .iter()
+        .map(|r| ColumnPart {
+            columns: r.clone(),
+            rows: Vec::with_capacity(rows),
+        })
+        .collect();
+    for s in &mut sections[start - 1..] {
+        let mut rest: &mut [glam::DVec3] = &mut s.points;
+        for part in &mut split {
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(part.columns.len());
+            part.rows.push(head);
+            rest = tail;
+        }
+    }
+    // edges[j][r]: part j's first and last point of section start − 1 + r, once finished.
+    let edges: Vec<Vec<OnceLock<(glam::DVec3, glam::DVec3)>>> = (0..count)
+        .map(|_| (0..rows).map(|_| OnceLock::new()).collect())
+        .collect();
+    // Set when a part stops early (a panic), so that its neighbours do not wait forever.
+    let stopped: Vec<AtomicBool> = (0..count).map(|_| AtomicBool::new(false)).collect();
+    let (edges, stopped) = (&edges, &stopped);
+    let wait = move |j: usize, r: usize| -> (glam::DVec3, glam::DVec3) {
+        loop {
+            if let Some(e) = edges[j][r].get() {
+                return *e;
+            }
+            assert!(
+                !stopped[j].load(Ordering::Acquire),
+                "a neighbouring part stopped"
+            );
+            std::hint::spin_loop();
+        }
+    };
+    let jobs: Vec<_> = split
+        .into_iter()
+        .enumerate()
+        .map(|(j, part)| {
+            move || {
+                struct Stop<'a>(&'a AtomicBool);
+                impl Drop for Stop<'_> {
+                    fn drop(&mut self) {
+                        self.0.store(true, Ordering::Release);
+                    }
+                }
+                let _stop = Stop(&stopped[j]);
+                let ColumnPart { columns, mut rows } = part;
+                let w = columns.len();
+                let (left, right) = ((j + count - 1) % count, (j + 1) % count);
+                let _ = edges[j][0].set((rows[0][0], rows[0][w - 1]));
+                let mut events = Vec::new();
+                let mut normals = Vec::with_capacity(w);
+                for r in 1..rows.len() {
+                    let before_first = wait(left, r - 1).1;
+                    let after_last = wait(right, r - 1).0;
+                    let (below, above) = rows.split_at_mut(r);
+                    let (prev, cur) = (&*below[r - 1], &mut *above[0]);
+                    normals.clear();
+                    normals.extend((0..w).map(|c| {
+                        let before = if c == 0 { before_first } else { prev[c - 1] };
+                        let after = if c + 1 == w { after_last } else { prev[c + 1] };
+                        crate::geometry::normal_from_neighbours(before.truncate(), after.truncate())
+                    }));
+                    let layer = start - 1 + r;
+                    for (c, p) in cur.iter_mut().enumerate() {
+                        if let Some(amount_mm) =
+                            clamp_point(p, prev[c], normals[c], tan_limit, enforce)
+                        {
+                            events.push(PointEvent {
+                                layer,
+                                sample: columns.start + c,
+                                amount_mm,
+                            });
+                        }
+                    }
+                    let _ = edges[j][r].set((cur[0], cur[w - 1]));
+                }
+                events
+            }
+        })
+        .collect();
+    let mut events: Vec<PointEvent> = crate::parallel::run_together(jobs)
+        .ok()?
+        .into_iter()
+        .flatten()
+        .collect();
+    events.sort_by_key(|e| (e.layer, e.sample));
+    Some(events)
+}
+
+/// Clamps point `p` against `q` below it (`n`: the outward normal of the section below at q);
+/// the excess when it leaned past the limit (moved back onto it when `enforce`).
+#[inline]
+fn clamp_point(
+    p: &mut glam::DVec3,
+    q: glam::DVec3,
+    n: DVec2,
+    tan_limit: f64,
+    enforce: bool,
+) -> Option<f64> {
+    let dz = (p.z - q.z).max(0.0);
+    let limit = dz * tan_limit;
+    let offset = (p.truncate() - q.truncate()).dot(n);
+    if offset.abs() > limit {
+        let excess = offset.abs() - limit;
+        if enforce {
+            let shift: DVec2 = n * (excess * offset.signum());
+            p.x -= shift.x;
+            p.y -= shift.y;
+        }
+        Some(excess)
+    } else {
+        None
+    }
+}
+
+/// [`clamp_overhang`] section by section on one core.
+fn clamp_by_rows(
+    sections: &mut [Section],
+    from: usize,
+    tan_limit: f64,
+    enforce: bool,
+) -> Vec<PointEvent> {
     let mut events = Vec::new();
     for k in from.max(1)..sections.len() {
         let (below, above) = sections.split_at_mut(k);
@@ -38,22 +207,12 @@ pub fn clamp_overhang(
         let cur = &mut above[0];
         let normals = prev.normals();
         for (i, p) in cur.points.iter_mut().enumerate() {
-            let q = prev.points[i];
-            let dz = (p.z - q.z).max(0.0);
-            let limit = dz * tan_limit;
-            let n = normals[i];
-            let offset = (p.truncate() - q.truncate()).dot(n);
-            if offset.abs() > limit {
-                let excess = offset.abs() - limit;
-                if enforce {
-                    let shift: DVec2 = n * (excess * offset.signum());
-                    p.x -= shift.x;
-                    p.y -= shift.y;
-                }
+            if let Some(amount_mm) = clamp_point(p, prev.points[i], normals[i], tan_limit, enforce)
+            {
                 events.push(PointEvent {
                     layer: k,
                     sample: i,
-                    amount_mm: excess,
+                    amount_mm,
                 });
             }
         }
@@ -190,6 +349,51 @@ fn measure_part(sections: &[Section], range: std::ops::Range<usize>) -> (Surface
 mod tests {
     use super::*;
     use glam::DVec3;
+
+    /// The clamp by columns on all cores moves every point exactly as the clamp section by
+    /// section, and reports the same events in the same order: a wavy, leaning wall with many
+    /// points past the limit, enforced and not, from the bottom and from half way up.
+    #[test]
+    fn the_clamp_by_columns_is_the_clamp_by_rows() {
+        if crate::parallel::cores() < 2 {
+            return; // No helper to run a second part at the same time.
+        }
+        let (rows, n) = (120, 300);
+        let wall: Vec<Section> = (0..rows)
+            .map(|k| Section {
+                points: (0..n)
+                    .map(|i| {
+                        let th = std::f64::consts::TAU * i as f64 / n as f64;
+                        let r = 40.0 + 0.3 * k as f64 + 2.5 * ((7 * i + 3 * k) as f64 * 0.37).sin();
+                        DVec3::new(r * th.cos(), r * th.sin(), k as f64)
+                    })
+                    .collect(),
+            })
+            .collect();
+        for enforce in [true, false] {
+            for from in [1, 60] {
+                let mut by_rows = wall.clone();
+                let expected = clamp_by_rows(&mut by_rows, from, 1.0, enforce);
+                assert!(expected.len() > 1000, "{}", expected.len());
+                let parts = crate::parallel::ranges(n, 2);
+                let parts = if parts.len() > 1 {
+                    parts
+                } else {
+                    vec![0..150, 150..300]
+                };
+                // Retried until the helpers are free (other tests use them too).
+                let (by_columns, events) = loop {
+                    let mut by_columns = wall.clone();
+                    if let Some(e) = clamp_by_columns(&mut by_columns, from, &parts, 1.0, enforce) {
+                        break (by_columns, e);
+                    }
+                    std::thread::yield_now();
+                };
+                assert_eq!(by_columns, by_rows);
+                assert_eq!(events, expected);
+            }
+        }
+    }
 
     /// The Cephes arctangent agrees with the library's to a few units in the last place, from
     /// 0 through tiny, reduction boundaries and huge arguments to infinity.

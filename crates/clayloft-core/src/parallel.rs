@@ -240,6 +240,41 @@ pub fn run_parts<R: Send, F: FnOnce() -> R + Send>(parts: Vec<F>) -> Vec<R> {
         .collect()
 }
 
+/// Runs every part at the same time, the last on this thread and each other on a helper of its
+/// own, for parts that wait on each other's progress (they would wait forever run one after
+/// another); gives the parts back unrun when not enough helpers are free.
+pub fn run_together<R: Send, F: FnOnce() -> R + Send>(parts: Vec<F>) -> Result<Vec<R>, Vec<F>> {
+    let wanted = parts.len().saturating_sub(1);
+    let mut helpers = Vec::with_capacity(wanted);
+    while helpers.len() < wanted {
+        match Helper::claim() {
+            Some(h) => helpers.push(h),
+            None => {
+                for h in helpers {
+                    h.claimed.store(false, Ordering::Release);
+                }
+                return Err(parts);
+            }
+        }
+    }
+    let mut results: Vec<Option<R>> = parts.iter().map(|_| None).collect();
+    let (last_slot, slots) = results.split_last_mut().expect("one part or more");
+    let mut parts = parts;
+    let last = parts.pop().expect("one part or more");
+    let handed: Vec<Handed> = parts
+        .into_iter()
+        .zip(slots.iter_mut())
+        .zip(helpers)
+        .map(|((part, slot), h)| h.hand(Box::new(move || *slot = Some(part()))))
+        .collect();
+    *last_slot = Some(last());
+    handed.into_iter().for_each(Handed::wait);
+    Ok(results
+        .into_iter()
+        .map(|r| r.expect("every part ran"))
+        .collect())
+}
+
 /// `0..len` cut into one contiguous range per core, or a single range when `len` is below
 /// `serial_below` (starting a thread costs more than small work).
 pub fn ranges(len: usize, serial_below: usize) -> Vec<Range<usize>> {

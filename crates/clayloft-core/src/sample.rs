@@ -39,10 +39,17 @@ pub fn sample_from_anchor(contour: &Contour, anchor: DVec2, count: usize) -> Vec
     resample_closed(&rotated, count)
 }
 
-/// Total twist `Σ |aᵢ − b₍ᵢ₊ₒ₎|²` for offset `o`.
+/// Total twist `Σ |aᵢ − b₍ᵢ₊ₒ₎|²` for offset `o` (summed in the order of i, without a division
+/// per term: b's indices wrap once, at i = n − o).
 fn twist(a: &[DVec2], b: &[DVec2], o: usize) -> f64 {
-    let n = a.len();
-    (0..n).map(|i| a[i].distance_squared(b[(i + o) % n])).sum()
+    let o = o % a.len().max(1);
+    let (a_head, a_tail) = a.split_at(a.len() - o);
+    let (b_head, b_tail) = b.split_at(o);
+    let mut sum = 0.0;
+    for (p, q) in a_head.iter().zip(b_tail).chain(a_tail.iter().zip(b_head)) {
+        sum += p.distance_squared(*q);
+    }
+    sum
 }
 
 /// The cyclic offset `o` minimising total twist between `lower` and `upper` (same length).
@@ -59,11 +66,25 @@ pub fn min_twist_offset(lower: &[DVec2], upper: &[DVec2]) -> usize {
             .unwrap_or(0)
     };
     if n <= 2048 {
-        return best_in(&mut (0..n));
+        // The offsets in parts on the machine's cores; the least (twist, offset) of the parts'
+        // is the least of all.
+        let parts = crate::parallel::map_ranges(n, 256, |r| vec![(twist_min(lower, upper, r))]);
+        return parts
+            .into_iter()
+            .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+            .map_or(0, |(_, o)| o);
     }
     let stride = n / 1024;
     let coarse = best_in(&mut (0..n).step_by(stride));
     best_in(&mut (0..=2 * stride).map(|d| (coarse + n + d - stride) % n))
+}
+
+/// The least (twist, offset) over the offsets `range` (the first of equal twists).
+fn twist_min(lower: &[DVec2], upper: &[DVec2], range: std::ops::Range<usize>) -> (f64, usize) {
+    range
+        .map(|o| (twist(lower, upper, o), o))
+        .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+        .unwrap_or((f64::INFINITY, 0))
 }
 
 /// Rotates `upper` by the minimal-twist offset so that `upper[i]` corresponds to `lower[i]`.

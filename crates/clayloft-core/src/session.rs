@@ -718,21 +718,10 @@ fn finish_stages(
     };
     let fills = later.base.get().expect("the base stage ran above");
     let beads = later.beads.get().expect("the bead stage ran above");
-    done.toolpath = later.toolpath.refresh(key, || {
-        build_toolpath_on(design, &surface, fills, beads).map(Arc::new)
-    })?;
 
-    // 7. Whether the wet wall stands while it is printed, and 8. the wall's mesh for a view
-    // (after the beads: a wall of several shows its inner bead). Each runs on one core, so they
-    // run side by side. (The mesh built beside the toolpath measured no faster: the toolpath's
-    // stages use both cores already.)
-    let toolpath = later.toolpath.get().expect("the toolpath stage ran above");
-    let verdict_key = VerdictKey {
-        toolpath: later.toolpath.revision,
-        clay: design.clay.clone(),
-        walls: design.shape.walls,
-        line_width: p.line_width,
-    };
+    // 8. The wall's mesh for a view (after the beads: a wall of several shows its inner bead)
+    // needs neither the base nor the toolpath: it is built on a second core while the toolpath
+    // is made on this one (each is one core's work).
     let view_key = wall_view.then_some(WallViewKey {
         surface: later.surface.revision,
         beads: later.beads.revision,
@@ -741,18 +730,11 @@ fn finish_stages(
     let points: usize = surface.sections.iter().map(|s| s.points.len()).sum();
     let beside = crate::parallel::cores() > 1
         && points >= PARALLEL_POINTS
-        && !later.verdict.is_current(&verdict_key)
+        && !later.toolpath.is_current(&key)
         && view_key.as_ref().is_some_and(|k| !later.view.is_current(k));
-    let (verdict, view) = (&mut later.verdict, &mut later.view);
-    let (verdict, view) = crate::parallel::both(
+    let (view, toolpath) = (&mut later.view, &mut later.toolpath);
+    let (view, toolpath) = crate::parallel::both(
         beside,
-        || {
-            verdict.refresh(verdict_key, || {
-                Ok(crate::printability::assess(design, toolpath)
-                    .ok()
-                    .map(Arc::new))
-            })
-        },
         || {
             view_key.map(|key| {
                 view.refresh(key, || {
@@ -764,9 +746,28 @@ fn finish_stages(
                 })
             })
         },
+        || {
+            toolpath.refresh(key, || {
+                build_toolpath_on(design, &surface, fills, beads).map(Arc::new)
+            })
+        },
     );
-    done.verdict = verdict?;
+    done.toolpath = toolpath?;
     done.wall_view = view.transpose()?.unwrap_or(false);
+
+    // 7. Whether the wet wall stands while it is printed.
+    let toolpath = later.toolpath.get().expect("the toolpath stage ran above");
+    let verdict_key = VerdictKey {
+        toolpath: later.toolpath.revision,
+        clay: design.clay.clone(),
+        walls: design.shape.walls,
+        line_width: p.line_width,
+    };
+    done.verdict = later.verdict.refresh(verdict_key, || {
+        Ok(crate::printability::assess(design, toolpath)
+            .ok()
+            .map(Arc::new))
+    })?;
     Ok(())
 }
 
