@@ -6,7 +6,7 @@
 use bevy::math::DVec3;
 use bevy::prelude::*;
 use clayloft_model::handles::{HandleRole, nudge_handle};
-use clayloft_model::preview::{toolpath_line, wall_mesh};
+use clayloft_model::preview::{toolpath_gizmo, wall_mesh};
 use clayloft_model::*;
 use criterion::{Criterion, criterion_group, criterion_main};
 
@@ -64,9 +64,7 @@ fn rebuild_mesh(app: &mut App) {
         .0
         .clone();
     // As the view draws it: a retained gizmo line strip (which stores linear colours).
-    let mut lines = GizmoAsset::new();
-    lines.linestrip_gradient(toolpath_line(&path));
-    std::hint::black_box(lines);
+    std::hint::black_box(toolpath_gizmo(&path));
 }
 
 fn bench(c: &mut Criterion) {

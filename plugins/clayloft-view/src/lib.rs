@@ -7,7 +7,7 @@ use bevy::picking::Pickable;
 use bevy::prelude::*;
 use bevy_panorbit_camera::PanOrbitCamera;
 use clayloft_model::coords::to_world;
-use clayloft_model::preview::{toolpath_line, wall_mesh};
+use clayloft_model::preview::{toolpath_gizmo, wall_mesh};
 use clayloft_model::*;
 
 /// What the view shows; the panels toggle these.
@@ -348,12 +348,11 @@ fn rebuild_toolpath_lines(
         return;
     }
     rebuilds.toolpath_lines += 1;
-    let mut asset = GizmoAsset::new();
-    if !settings.show_toolpath {
-        let _ = assets.insert(view.handle.id(), asset);
-        return;
-    }
-    asset.linestrip_gradient(toolpath_line(&path.0));
+    let asset = if settings.show_toolpath {
+        toolpath_gizmo(&path.0)
+    } else {
+        GizmoAsset::new()
+    };
     let _ = assets.insert(view.handle.id(), asset);
 }
 
