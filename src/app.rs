@@ -250,7 +250,10 @@ mod tests {
             .world()
             .resource::<clayloft_model::RecomputeLog>()
             .passes;
-        let rebuilds = *app.world().resource::<clayloft_view::ViewRebuilds>();
+        let rebuilds = app
+            .world()
+            .resource::<clayloft_view::ViewRebuilds>()
+            .counts();
         assert_eq!(passes, 1);
         assert_eq!(rebuilds.wall_mesh, 1);
         app.world_mut().resource_mut::<Changes>().0 = 0;
@@ -265,7 +268,9 @@ mod tests {
             "recomputed while idle"
         );
         assert_eq!(
-            *app.world().resource::<clayloft_view::ViewRebuilds>(),
+            app.world()
+                .resource::<clayloft_view::ViewRebuilds>()
+                .counts(),
             rebuilds,
             "rebuilt while idle"
         );

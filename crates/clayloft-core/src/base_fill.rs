@@ -302,7 +302,7 @@ fn without_spikes(mut pts: Vec<DVec2>) -> Vec<DVec2> {
 /// it, kept exactly with its arcs (erosion by w after erosion by d is erosion by d + w, and the
 /// offset of an arc is an arc: nothing is lost from level to level), and the offset by w/2
 /// where that middle ring is not covered by a deeper one.
-fn ring_tree(foot: &[DVec2], w: f64) -> Result<Node, FillError> {
+fn ring_tree(foot: &[DVec2], w: f64, rings_made: impl FnOnce()) -> Result<Node, FillError> {
     let max_levels = ring_levels(foot, w);
     if max_levels > MAX_RING_LEVELS {
         return Err(FillError::TooDeep { levels: max_levels });
@@ -313,6 +313,7 @@ fn ring_tree(foot: &[DVec2], w: f64) -> Result<Node, FillError> {
         children: Vec::new(),
     };
     grow(&mut root, &polyline(foot), w, max_levels)?;
+    rings_made();
     orient(&mut root, true, w);
     prune_spurs(&mut root);
     Ok(root)
@@ -701,6 +702,16 @@ pub fn fill_foot(foot: &[DVec2], w: f64) -> Result<BaseFill, FillError> {
 /// first foot on every layer, so that each layer's beads lie on the beads below; only the
 /// outline (and the bridge from it) follows each layer's own foot.
 pub fn fill_feet(feet: &[Vec<DVec2>], w: f64) -> Result<Vec<BaseFill>, FillError> {
+    fill_feet_then(feet, w, || ())
+}
+
+/// [`fill_feet`], calling `rings_made` once the rings are made, before the bridges are laid:
+/// from there on the fill uses one core, so a caller can start other work beside it.
+pub fn fill_feet_then(
+    feet: &[Vec<DVec2>],
+    w: f64,
+    rings_made: impl FnOnce(),
+) -> Result<Vec<BaseFill>, FillError> {
     let Some(first) = feet.first() else {
         return Ok(Vec::new());
     };
@@ -712,7 +723,7 @@ pub fn fill_feet(feet: &[Vec<DVec2>], w: f64) -> Result<Vec<BaseFill>, FillError
         return Err(FillError::NarrowerThanABead);
     }
     let narrow = narrow_spot(first, &eroded, w);
-    let inner = ring_tree(first, w)?;
+    let inner = ring_tree(first, w, rings_made)?;
     // The bridges from the outline are placed on the first foot and entered at the same points
     // of the inner rings on every layer, so that the layers' bridges stack.
     let first_root = Node {
@@ -995,7 +1006,7 @@ mod tests {
             );
             pts.push(DVec2::new(x, y));
         }
-        let tree = ring_tree(&pts, W).unwrap();
+        let tree = ring_tree(&pts, W, || ()).unwrap();
         fn splits(n: &Node) -> bool {
             n.children.len() >= 2 || n.children.iter().any(splits)
         }

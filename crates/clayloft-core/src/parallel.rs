@@ -240,6 +240,51 @@ pub fn run_parts<R: Send, F: FnOnce() -> R + Send>(parts: Vec<F>) -> Vec<R> {
         .collect()
 }
 
+/// Work started on a free helper while this thread goes on ([`beside`]); [`Beside::join`]
+/// gives its result.
+pub struct Beside<T> {
+    state: BesideState<T>,
+}
+
+enum BesideState<T> {
+    /// Running on a helper; the result lands in the slot.
+    Handed(Handed, std::sync::Arc<Mutex<Option<T>>>),
+    /// No helper was free: it runs on joining.
+    Later(Box<dyn FnOnce() -> T + Send>),
+}
+
+/// Starts `f` on a free helper and returns at once (the work owns what it uses, so that it can
+/// outlive the caller's frame); without a free helper, `f` runs when joined. For work that
+/// the next stages do not wait for (the view's mesh beside the base fill and the toolpath).
+pub fn beside<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> Beside<T> {
+    let state = match Helper::claim() {
+        Some(h) => {
+            let slot = std::sync::Arc::new(Mutex::new(None));
+            let out = std::sync::Arc::clone(&slot);
+            let handed = h.hand(Box::new(move || {
+                *out.lock().unwrap_or_else(|e| e.into_inner()) = Some(f());
+            }));
+            BesideState::Handed(handed, slot)
+        }
+        None => BesideState::Later(Box::new(f)),
+    };
+    Beside { state }
+}
+
+impl<T> Beside<T> {
+    /// Waits for the work (or does it now); its panic goes on here.
+    pub fn join(self) -> T {
+        match self.state {
+            BesideState::Handed(handed, slot) => {
+                handed.wait();
+                let result = slot.lock().unwrap_or_else(|e| e.into_inner()).take();
+                result.expect("the helper ran the work")
+            }
+            BesideState::Later(f) => f(),
+        }
+    }
+}
+
 /// Runs every part at the same time, the last on this thread and each other on a helper of its
 /// own, for parts that wait on each other's progress (they would wait forever run one after
 /// another); gives the parts back unrun when not enough helpers are free.
@@ -430,5 +475,20 @@ mod tests {
             );
             assert_eq!(got, (0..100).collect::<Vec<_>>());
         }
+    }
+
+    /// Work started beside the caller gives its result on joining, whether a helper took it
+    /// or not, and its panic goes on in the joining thread.
+    #[test]
+    fn work_beside_gives_its_result_on_joining() {
+        let data = std::sync::Arc::new((0..10_000u64).collect::<Vec<_>>());
+        let d = std::sync::Arc::clone(&data);
+        let sum = beside(move || d.iter().sum::<u64>());
+        // Meanwhile the helper may be busy: parts started here run here.
+        assert_eq!(run_parts(vec![|| 1, || 2]), vec![1, 2]);
+        assert_eq!(sum.join(), 49_995_000);
+        let failed = beside(|| -> u32 { panic!("beside") });
+        assert!(std::panic::catch_unwind(AssertUnwindSafe(|| failed.join())).is_err());
+        assert_eq!(beside(|| 7).join(), 7);
     }
 }

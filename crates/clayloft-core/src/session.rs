@@ -686,15 +686,6 @@ fn finish_stages(
         .get()
         .cloned()
         .expect("the surface stage ran above");
-    // The base fill is kept while the feet are the same (an edit higher up the wall).
-    let key = BaseKey {
-        feet: crate::toolpath::base_feet(design, &surface),
-        line_width: p.line_width,
-        wall: (surface.layers, surface.sections[0].points.len()),
-    };
-    later
-        .base
-        .refresh(key, || crate::toolpath::base_fills(design, &surface))?;
     let key = BeadKey {
         surface: later.surface.revision,
         walls: design.shape.walls,
@@ -703,6 +694,41 @@ fn finish_stages(
     };
     done.beads = later.beads.refresh(key, || {
         crate::toolpath::inner_beads(design, &surface).map(Arc::new)
+    })?;
+    let beads = Arc::clone(later.beads.get().expect("the bead stage ran above"));
+
+    // 8. The wall's mesh for a view (after the beads: a wall of several shows its inner bead)
+    // needs neither the base nor the toolpath, which use one core once the base fill's rings
+    // are made: it is built on a second core from then on (or beside the toolpath when the
+    // base is kept).
+    let view_key = wall_view.then_some(WallViewKey {
+        surface: later.surface.revision,
+        beads: later.beads.revision,
+        limit_deg: p.max_overhang_deg,
+    });
+    let points: usize = surface.sections.iter().map(|s| s.points.len()).sum();
+    let view_beside = crate::parallel::cores() > 1
+        && points >= PARALLEL_POINTS
+        && view_key.as_ref().is_some_and(|k| !later.view.is_current(k));
+    let mut build_view = Some({
+        let (surface, beads, limit) =
+            (Arc::clone(&surface), Arc::clone(&beads), p.max_overhang_deg);
+        move || crate::view_mesh::wall_buffers(&surface, beads.last().map(Vec::as_slice), limit)
+    });
+    let mut view_started = None;
+
+    // The base fill is kept while the feet are the same (an edit higher up the wall).
+    let key = BaseKey {
+        feet: crate::toolpath::base_feet(design, &surface),
+        line_width: p.line_width,
+        wall: (surface.layers, surface.sections[0].points.len()),
+    };
+    later.base.refresh(key, || {
+        crate::toolpath::base_fills_then(design, &surface, || {
+            if view_beside && let Some(build) = build_view.take() {
+                view_started = Some(crate::parallel::beside(build));
+            }
+        })
     })?;
     let key = ToolpathKey {
         surface: later.surface.revision,
@@ -717,41 +743,29 @@ fn finish_stages(
         flow_ramp: (p.flow_ramp_start, p.flow_ramp_end),
     };
     let fills = later.base.get().expect("the base stage ran above");
-    let beads = later.beads.get().expect("the bead stage ran above");
-
-    // 8. The wall's mesh for a view (after the beads: a wall of several shows its inner bead)
-    // needs neither the base nor the toolpath: it is built on a second core while the toolpath
-    // is made on this one (each is one core's work).
-    let view_key = wall_view.then_some(WallViewKey {
-        surface: later.surface.revision,
-        beads: later.beads.revision,
-        limit_deg: p.max_overhang_deg,
-    });
-    let points: usize = surface.sections.iter().map(|s| s.points.len()).sum();
-    let beside = crate::parallel::cores() > 1
-        && points >= PARALLEL_POINTS
-        && !later.toolpath.is_current(&key)
-        && view_key.as_ref().is_some_and(|k| !later.view.is_current(k));
-    let (view, toolpath) = (&mut later.view, &mut later.toolpath);
-    let (view, toolpath) = crate::parallel::both(
-        beside,
-        || {
-            view_key.map(|key| {
-                view.refresh(key, || {
-                    Ok(Arc::new(crate::view_mesh::wall_buffers(
-                        &surface,
-                        beads.last().map(Vec::as_slice),
-                        p.max_overhang_deg,
-                    )))
-                })
-            })
-        },
-        || {
-            toolpath.refresh(key, || {
-                build_toolpath_on(design, &surface, fills, beads).map(Arc::new)
-            })
-        },
-    );
+    let toolpath = &mut later.toolpath;
+    let make_toolpath = || {
+        toolpath.refresh(key, || {
+            build_toolpath_on(design, &surface, fills, &beads).map(Arc::new)
+        })
+    };
+    let view = &mut later.view;
+    let (view, toolpath) = match view_started {
+        Some(started) => {
+            let toolpath = make_toolpath();
+            let buffers = started.join();
+            let view = view_key.map(|key| view.refresh(key, || Ok(Arc::new(buffers))));
+            (view, toolpath)
+        }
+        None => crate::parallel::both(
+            view_beside,
+            || {
+                let build = build_view.expect("the view was not started");
+                view_key.map(|key| view.refresh(key, || Ok(Arc::new(build()))))
+            },
+            make_toolpath,
+        ),
+    };
     done.toolpath = toolpath?;
     done.wall_view = view.transpose()?.unwrap_or(false);
 

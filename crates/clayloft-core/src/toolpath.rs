@@ -143,6 +143,16 @@ pub fn base_fills(
     design: &Design,
     surface: &Surface,
 ) -> Result<Vec<crate::base_fill::BaseFill>, FieldError> {
+    base_fills_then(design, surface, || ())
+}
+
+/// [`base_fills`], calling `rings_made` once the fill's rings are made (from there on it uses
+/// one core; see [`crate::base_fill::fill_feet_then`]). Not called when there is nothing to fill.
+pub fn base_fills_then(
+    design: &Design,
+    surface: &Surface,
+    rings_made: impl FnOnce(),
+) -> Result<Vec<crate::base_fill::BaseFill>, FieldError> {
     let p = &design.printer;
     let feet = base_feet(design, surface);
     let (base, n) = (feet.len(), surface.sections[0].points.len());
@@ -165,7 +175,7 @@ pub fn base_fills(
             ));
         }
     }
-    crate::base_fill::fill_feet(&feet, p.line_width).map_err(|e| {
+    crate::base_fill::fill_feet_then(&feet, p.line_width, rings_made).map_err(|e| {
         FieldError::new(
             "shape.base_layers",
             match e {

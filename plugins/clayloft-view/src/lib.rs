@@ -46,10 +46,29 @@ pub struct ToolpathView;
 pub struct BedView;
 
 /// How often the view rebuilt its meshes and lines (tests count them over idle frames: zero).
-#[derive(Resource, Debug, Clone, Copy, Default, PartialEq, Eq)]
+/// Counted with atomics, so that the systems that rebuild the wall and the lines only read the
+/// resource and Bevy runs them side by side.
+#[derive(Resource, Debug, Default)]
 pub struct ViewRebuilds {
+    wall_mesh: std::sync::atomic::AtomicU64,
+    toolpath_lines: std::sync::atomic::AtomicU64,
+}
+
+/// The counts of [`ViewRebuilds`] at one moment.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RebuildCounts {
     pub wall_mesh: u64,
     pub toolpath_lines: u64,
+}
+
+impl ViewRebuilds {
+    pub fn counts(&self) -> RebuildCounts {
+        use std::sync::atomic::Ordering::Relaxed;
+        RebuildCounts {
+            wall_mesh: self.wall_mesh.load(Relaxed),
+            toolpath_lines: self.toolpath_lines.load(Relaxed),
+        }
+    }
 }
 
 /// Number of wall points past the overhang limit (for the status line).
@@ -284,7 +303,7 @@ fn rebuild_wall_mesh(
     wall: Single<&Mesh3d, With<WallView>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut stats: ResMut<WallStats>,
-    mut rebuilds: ResMut<ViewRebuilds>,
+    rebuilds: Res<ViewRebuilds>,
     mut coloured_by_safety: Local<bool>,
 ) {
     let Some(mesh) = vessel.iter().next() else {
@@ -299,7 +318,9 @@ fn rebuild_wall_mesh(
         return;
     }
     *coloured_by_safety = by_safety;
-    rebuilds.wall_mesh += 1;
+    rebuilds
+        .wall_mesh
+        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     // The session's buffers are shared with the replay: the asset gets its own copy.
     let mut buffers = (*mesh.0).clone();
     stats.violating_points = buffers.violating;
@@ -339,7 +360,7 @@ fn rebuild_toolpath_lines(
     settings: Res<ViewSettings>,
     view: Single<&Gizmo, With<ToolpathView>>,
     mut assets: ResMut<Assets<GizmoAsset>>,
-    mut rebuilds: ResMut<ViewRebuilds>,
+    rebuilds: Res<ViewRebuilds>,
 ) {
     let Some(path) = path.iter().next() else {
         return;
@@ -347,7 +368,9 @@ fn rebuild_toolpath_lines(
     if !path.is_changed() && !settings.is_changed() {
         return;
     }
-    rebuilds.toolpath_lines += 1;
+    rebuilds
+        .toolpath_lines
+        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let asset = if settings.show_toolpath {
         toolpath_gizmo(&path.0)
     } else {
