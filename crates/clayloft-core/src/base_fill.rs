@@ -302,7 +302,15 @@ fn without_spikes(mut pts: Vec<DVec2>) -> Vec<DVec2> {
 /// it, kept exactly with its arcs (erosion by w after erosion by d is erosion by d + w, and the
 /// offset of an arc is an arc: nothing is lost from level to level), and the offset by w/2
 /// where that middle ring is not covered by a deeper one.
-fn ring_tree(foot: &[DVec2], w: f64, rings_made: impl FnOnce()) -> Result<Node, FillError> {
+///
+/// `meanwhile` runs on this core once the rings are made, while a second may still be making
+/// the middle rings (not at all when the foot is too deep); `rings_made` once both are done.
+fn ring_tree(
+    foot: &[DVec2],
+    w: f64,
+    rings_made: impl FnOnce(),
+    meanwhile: impl FnOnce(),
+) -> Result<Node, FillError> {
     let max_levels = ring_levels(foot, w);
     if max_levels > MAX_RING_LEVELS {
         return Err(FillError::TooDeep { levels: max_levels });
@@ -312,7 +320,7 @@ fn ring_tree(foot: &[DVec2], w: f64, rings_made: impl FnOnce()) -> Result<Node, 
         step: 0.0,
         children: Vec::new(),
     };
-    grow(&mut root, &polyline(foot), w, max_levels)?;
+    grow(&mut root, &polyline(foot), w, max_levels, meanwhile)?;
     rings_made();
     orient(&mut root, true, w);
     prune_spurs(&mut root);
@@ -326,8 +334,21 @@ fn ring_tree(foot: &[DVec2], w: f64, rings_made: impl FnOnce()) -> Result<Node, 
 /// offsets them while this one goes down the rings: [`grow_rings`] hands each ring's exact
 /// outline over as it is made, [`add_middles`] puts their offsets in afterwards, in the same
 /// order. The tree is the one made on one core.
-fn grow(root: &mut Node, exact: &Polyline<f64>, w: f64, levels: usize) -> Result<(), FillError> {
-    grow_on(root, exact, w, levels, crate::parallel::cores() > 1)
+fn grow(
+    root: &mut Node,
+    exact: &Polyline<f64>,
+    w: f64,
+    levels: usize,
+    meanwhile: impl FnOnce(),
+) -> Result<(), FillError> {
+    grow_on(
+        root,
+        exact,
+        w,
+        levels,
+        crate::parallel::cores() > 1,
+        meanwhile,
+    )
 }
 
 /// [`grow`], with the middle rings on a second thread or not.
@@ -337,6 +358,7 @@ fn grow_on(
     w: f64,
     levels: usize,
     two_threads: bool,
+    meanwhile: impl FnOnce(),
 ) -> Result<(), FillError> {
     let (send, receive) = std::sync::mpsc::channel::<Polyline<f64>>();
     // On a helper this waits for each ring by spinning (a ring takes tens of microseconds, a
@@ -354,6 +376,7 @@ fn grow_on(
     let (middles, grown) = crate::parallel::both(two_threads && levels > 1, offset_all, || {
         let grown = grow_rings(root, exact, w, levels, &send);
         drop(send);
+        meanwhile();
         grown
     });
     grown?;
@@ -718,12 +741,19 @@ pub fn fill_feet_then(
     if feet.iter().any(|f| f.len() < 3) || w.is_nan() || w <= 0.0 {
         return Err(FillError::NarrowerThanABead);
     }
-    let eroded = offset(&polyline(first), 0.5 * w)?;
-    if eroded.is_empty() {
-        return Err(FillError::NarrowerThanABead);
-    }
-    let narrow = narrow_spot(first, &eroded, w);
-    let inner = ring_tree(first, w, rings_made)?;
+    // Where the foot is narrower than a bead: measured on this core once the rings are made,
+    // while the second finishes the middle rings (its error comes first, as if run first).
+    let narrowness = || -> Result<Option<NarrowSpot>, FillError> {
+        let eroded = offset(&polyline(first), 0.5 * w)?;
+        if eroded.is_empty() {
+            return Err(FillError::NarrowerThanABead);
+        }
+        Ok(narrow_spot(first, &eroded, w))
+    };
+    let mut measured = None;
+    let tree = ring_tree(first, w, rings_made, || measured = Some(narrowness()));
+    let narrow = measured.unwrap_or_else(narrowness)?;
+    let inner = tree?;
     // The bridges from the outline are placed on the first foot and entered at the same points
     // of the inner rings on every layer, so that the layers' bridges stack.
     let first_root = Node {
@@ -953,7 +983,7 @@ mod tests {
                     step: 0.0,
                     children: Vec::new(),
                 };
-                grow_on(&mut root, &polyline(&foot), 3.0, levels, two).unwrap();
+                grow_on(&mut root, &polyline(&foot), 3.0, levels, two, || ()).unwrap();
                 format!("{root:?}")
             };
             assert_eq!(grown(true), grown(false));
@@ -1006,7 +1036,7 @@ mod tests {
             );
             pts.push(DVec2::new(x, y));
         }
-        let tree = ring_tree(&pts, W, || ()).unwrap();
+        let tree = ring_tree(&pts, W, || (), || ()).unwrap();
         fn splits(n: &Node) -> bool {
             n.children.len() >= 2 || n.children.iter().any(splits)
         }

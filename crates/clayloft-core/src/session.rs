@@ -282,7 +282,7 @@ pub struct MeshWallKey {
 pub struct Session {
     contours: [Stage<ContourKey, SampledContour>; 2],
     plan: Stage<PlanKey, (ShapeModel, Vec<Finding>)>,
-    sections: Vec<Stage<SectionKey, Section>>,
+    sections: Vec<Stage<SectionKey, Arc<Section>>>,
     /// Bumped whenever any section is recomputed or the section count changes.
     sections_revision: u64,
     /// The stages after the shape, lofted or sliced: texture, surface, base, beads, toolpath,
@@ -435,7 +435,7 @@ impl Session {
         if !dirty.is_empty() {
             let shaped = shape_sections(model, &dirty);
             for (&k, section) in dirty.iter().zip(shaped) {
-                self.sections[k].value = Some(section);
+                self.sections[k].value = Some(Arc::new(section));
             }
             self.sections_revision += 1;
         }
@@ -456,10 +456,13 @@ impl Session {
             grid,
             surface_inputs,
             || {
-                sections
-                    .iter()
-                    .map(|s| s.value.clone().unwrap_or_default())
-                    .collect()
+                // Copied on both cores: the surface stage corrects its own copy.
+                crate::parallel::map_ranges(sections.len(), 64, |r| {
+                    sections[r]
+                        .iter()
+                        .map(|s| s.value.as_deref().cloned().unwrap_or_default())
+                        .collect()
+                })
             },
             plan_findings,
         )?;
@@ -536,7 +539,17 @@ impl Session {
         if self.from_mesh {
             return self.mesh_wall.get()?.get(k);
         }
-        self.sections.get(k)?.get()
+        self.sections.get(k)?.get().map(|s| &**s)
+    }
+
+    /// [`Session::shaped_section`], shared: a lofted design's sections are kept behind an `Arc`,
+    /// so that an application can hold them without copying their points on every edit (a
+    /// mesh's wall sections are copied).
+    pub fn shaped_section_shared(&self, k: usize) -> Option<Arc<Section>> {
+        if self.from_mesh {
+            return self.mesh_wall.get()?.get(k).cloned().map(Arc::new);
+        }
+        self.sections.get(k)?.get().cloned()
     }
 
     /// The corrected, textured surface.

@@ -48,9 +48,10 @@ pub struct ContourSamples {
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SectionIndex(pub usize);
 
-/// The shaped section (loft + control lines, before constraints and texture).
+/// The shaped section (loft + control lines, before constraints and texture), shared with the
+/// session.
 #[derive(Component, Debug, Clone, Default)]
-pub struct ShapedSection(pub Section);
+pub struct ShapedSection(pub std::sync::Arc<Section>);
 
 /// Marker of the vessel entity.
 #[derive(Component, Debug, Clone, Copy, Default)]

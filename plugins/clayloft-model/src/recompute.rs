@@ -131,14 +131,14 @@ pub fn recompute_model(
         }
         present[k] = true;
         if update.sections.binary_search(&k).is_ok()
-            && let Some(s) = session.shaped_section(k)
+            && let Some(s) = session.shaped_section_shared(k)
         {
-            section.0 = s.clone();
+            section.0 = s;
         }
     }
     for (k, _) in present.iter().enumerate().filter(|(_, p)| !**p) {
-        if let Some(s) = session.shaped_section(k) {
-            commands.spawn((SectionIndex(k), ShapedSection(s.clone())));
+        if let Some(s) = session.shaped_section_shared(k) {
+            commands.spawn((SectionIndex(k), ShapedSection(s)));
         }
     }
     // The corrected surface and the toolpath, shared with the session.
