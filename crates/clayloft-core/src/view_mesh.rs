@@ -125,37 +125,44 @@ pub fn wall_buffers(
                 .iter()
                 .flat_map(|s| s.points.iter().map(|p| to_view(*p).to_array())),
         );
-        let at = |k: usize, i: usize| Vec3::from_array(b.positions[first + k * n + i]);
+        let sheet_positions = &b.positions[first..first + rows * n];
+        let row = |k: usize| &sheet_positions[k * n..(k + 1) * n];
         let mut normals = Vec::with_capacity(rows * n);
         for k in 0..rows {
-            let (kd, ku) = (k.saturating_sub(1), (k + 1).min(rows - 1));
-            for i in 0..n {
-                let (before, after) = crate::geometry::ring_neighbours(i, n);
-                let around = at(k, after) - at(k, before);
-                let up = at(ku, i) - at(kd, i);
-                // Contours run counter-clockwise seen from above: around × up points outward.
-                normals.push((outward * around.cross(up).normalize_or_zero()).to_array());
-            }
+            let (here, down, up) = (row(k), row(k.saturating_sub(1)), row((k + 1).min(rows - 1)));
+            // Central differences around the ring and up the wall; contours run
+            // counter-clockwise seen from above: around × up points outward.
+            let normal = |before: usize, i: usize, after: usize| {
+                let around = Vec3::from_array(here[after]) - Vec3::from_array(here[before]);
+                let up = Vec3::from_array(up[i]) - Vec3::from_array(down[i]);
+                (outward * around.cross(up).normalize_or_zero()).to_array()
+            };
+            normals.push(normal(n - 1, 0, 1));
+            normals.extend((1..n - 1).map(|i| normal(i - 1, i, i + 1)));
+            normals.push(normal(n - 2, n - 1, 0));
         }
         b.normals.extend(normals);
         b.colors.extend(leans.iter().map(|a| lean_color(*a, limit)));
     }
-    b.indices.reserve((rows - 1) * b.indices_per_row);
-    for k in 0..rows - 1 {
-        for sheet in 0..sheets.len() {
-            let base = sheet * rows * n;
-            let (r0, r1) = ((base + k * n) as u32, (base + (k + 1) * n) as u32);
-            for i in 0..n as u32 {
-                let j = if i + 1 == n as u32 { 0 } else { i + 1 };
-                if sheet == 0 {
-                    b.indices
-                        .extend_from_slice(&[r0 + i, r0 + j, r1 + j, r0 + i, r1 + j, r1 + i]);
-                } else {
-                    b.indices
-                        .extend_from_slice(&[r0 + i, r1 + j, r0 + j, r0 + i, r1 + i, r1 + j]);
-                }
+    // Each row's triangles are those of the first row moved on by k·n vertices: the first
+    // row's are made once (sheet by sheet) and offset.
+    let mut first_row = Vec::with_capacity(b.indices_per_row);
+    for sheet in 0..sheets.len() {
+        let r0 = (sheet * rows * n) as u32;
+        let r1 = r0 + n as u32;
+        for i in 0..n as u32 {
+            let j = if i + 1 == n as u32 { 0 } else { i + 1 };
+            if sheet == 0 {
+                first_row.extend_from_slice(&[r0 + i, r0 + j, r1 + j, r0 + i, r1 + j, r1 + i]);
+            } else {
+                first_row.extend_from_slice(&[r0 + i, r1 + j, r0 + j, r0 + i, r1 + i, r1 + j]);
             }
         }
+    }
+    b.indices.reserve((rows - 1) * b.indices_per_row);
+    for k in 0..rows - 1 {
+        let shift = (k * n) as u32;
+        b.indices.extend(first_row.iter().map(|v| v + shift));
     }
     if sheets.len() > 1 {
         // The rim between the sheets, facing up (last, so a replay shows it with the top row).
@@ -246,6 +253,53 @@ mod tests {
             let radial = (Vec3::from_array(*p) - c).with_y(0.0).normalize();
             assert!(radial.dot(Vec3::from_array(*nrm)) > 0.999, "{p:?} {nrm:?}");
         }
+    }
+
+    #[test]
+    /// The normals and the triangles are those of the plain loops (each vertex's neighbours
+    /// taken round the ring, each row's quads one by one): a textured two-bead wall.
+    fn the_buffers_are_the_plain_loops() {
+        let d = crate::load::parse_design(
+            "version = 1\n[shape]\nheight = 20.0\nsamples = 48\nbase_layers = 0\nwalls = 2\n\
+             lower = { type = \"rose\", radius = 30.0, amplitude = 3.0, petals = 5 }\n\
+             upper = { type = \"circle\", radius = 26.0 }\n\
+             [texture]\nx = { wave = \"sine\", period = 10.0, amplitude = 1.0 }\n",
+        )
+        .unwrap();
+        let job = crate::run(&d).unwrap();
+        let b = wall_buffers(&job.surface, job.beads.last().map(Vec::as_slice), 45.0);
+        let (rows, n) = (job.surface.sections.len(), 48);
+        let mut normals = Vec::new();
+        let mut indices = Vec::new();
+        for (sheet, outward) in [(0, 1.0), (1, -1.0f32)] {
+            let at =
+                |k: usize, i: usize| Vec3::from_array(b.positions[sheet * rows * n + k * n + i]);
+            for k in 0..rows {
+                let (kd, ku) = (k.saturating_sub(1), (k + 1).min(rows - 1));
+                for i in 0..n {
+                    let (before, after) = crate::geometry::ring_neighbours(i, n);
+                    let around = at(k, after) - at(k, before);
+                    let up = at(ku, i) - at(kd, i);
+                    normals.push((outward * around.cross(up).normalize_or_zero()).to_array());
+                }
+            }
+        }
+        for k in 0..rows - 1 {
+            for sheet in 0..2 {
+                let base = sheet * rows * n;
+                let (r0, r1) = ((base + k * n) as u32, (base + (k + 1) * n) as u32);
+                for i in 0..n as u32 {
+                    let j = (i + 1) % n as u32;
+                    indices.extend_from_slice(&if sheet == 0 {
+                        [r0 + i, r0 + j, r1 + j, r0 + i, r1 + j, r1 + i]
+                    } else {
+                        [r0 + i, r1 + j, r0 + j, r0 + i, r1 + i, r1 + j]
+                    });
+                }
+            }
+        }
+        assert_eq!(b.normals[..2 * rows * n], normals[..]);
+        assert_eq!(b.indices[..indices.len()], indices[..]);
     }
 
     #[test]
