@@ -364,11 +364,19 @@ fn grow_on(
     // On a helper this waits for each ring by spinning (a ring takes tens of microseconds, a
     // sleeping thread as long to wake); run after the rings, it finds them all sent.
     let offset_all = move || -> Vec<_> {
-        let mut out = Vec::new();
+        let (mut out, mut spins) = (Vec::new(), 0u32);
         loop {
             match receive.try_recv() {
                 Ok(pl) => out.push(offset(&pl, 0.5 * w)),
-                Err(std::sync::mpsc::TryRecvError::Empty) => std::hint::spin_loop(),
+                Err(std::sync::mpsc::TryRecvError::Empty) => {
+                    // Let the ring maker have the core should it have lost its own.
+                    spins = spins.wrapping_add(1);
+                    if spins % 65_536 == 0 {
+                        std::thread::yield_now();
+                    } else {
+                        std::hint::spin_loop();
+                    }
+                }
                 Err(std::sync::mpsc::TryRecvError::Disconnected) => return out,
             }
         }
