@@ -20,7 +20,9 @@
 //! 6. the toolpath: the one continuous spiral (`toolpath::build_toolpath_on`);
 //! 7. the verdict: whether the wet wall stands while it is printed (`printability::assess`);
 //! 8. for a session made [`Session::with_wall_view`], the wall's mesh for a 3D view
-//!    (`view_mesh::wall_buffers`), so that an application's view and replay share one.
+//!    (`view_mesh::wall_buffers`), so that an application's view and replay share one; it is
+//!    built on a second core from the moment the base fill's rings are made (beside the
+//!    bridges and the toolpath), or beside the toolpath when the base is kept.
 //!
 //! The batch [`crate::run`] is a fresh session's first update.
 
