@@ -113,7 +113,7 @@ fn clamp_by_columns(
             // A section takes about a microsecond; a neighbour that long late has lost its
             // core: let it have this one.
             spins = spins.wrapping_add(1);
-            if spins % 4096 == 0 {
+            if spins.is_multiple_of(4096) {
                 std::thread::yield_now();
             } else {
                 std::hint::spin_loop();

@@ -107,7 +107,7 @@ impl Helper {
             }
             spins = spins.wrapping_add(1);
             if pool().awake.load(Ordering::Relaxed) > 0
-                || spins % 64 != 0
+                || !spins.is_multiple_of(64)
                 || last.elapsed() < LINGER
             {
                 std::hint::spin_loop();
@@ -162,7 +162,7 @@ impl Handed {
         while !self.helper.done.load(Ordering::Acquire) {
             spins = spins.wrapping_add(1);
             // Spin while the part is short; then give the core to other threads.
-            if spins % 64 == 0 && started.elapsed() > Duration::from_micros(100) {
+            if spins.is_multiple_of(64) && started.elapsed() > Duration::from_micros(100) {
                 std::thread::yield_now();
             } else {
                 std::hint::spin_loop();
