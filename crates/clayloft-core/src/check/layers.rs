@@ -188,33 +188,136 @@ fn seek<T>(v: &[T], guess: usize, pred: impl Fn(&T) -> bool) -> usize {
 /// Spatial hash of path chords in XY columns.
 struct ChordGrid {
     cell: f64,
-    columns: HashMap<CellKey, Column, FixedState>,
-    /// Insertions left before the grid gives up (see [`INSERTIONS_PER_CHORD`]).
-    budget: usize,
+    /// Each column's place in `columns`.
+    index: HashMap<CellKey, u32, FixedState>,
+    columns: Vec<Column>,
 }
 
 impl ChordGrid {
     fn key(&self, p: DVec2) -> CellKey {
-        (
-            (p.x / self.cell).floor() as i32,
-            (p.y / self.cell).floor() as i32,
-        )
+        column_key(self.cell, p)
+    }
+
+    /// The grid of chords `chords` of path `v` that lie inside the machine, in columns `cell`
+    /// mm across; built in parts of the chords on every core (from `serial_below` chords) and
+    /// joined column by column (each part's chords follow the previous part's, so every column
+    /// stays in path order). None when the chords need more than `budget` column insertions in
+    /// all.
+    fn build(
+        v: &[DVec3],
+        chords: &[(usize, usize)],
+        cell: f64,
+        inside: &(impl Fn(DVec3) -> bool + Sync),
+        budget: usize,
+        serial_below: usize,
+    ) -> Option<ChordGrid> {
+        let parts = crate::parallel::ranges(chords.len(), serial_below);
+        let built = crate::parallel::run_parts(
+            parts
+                .into_iter()
+                .map(|range| move || GridPart::build(v, chords, range, cell, inside, budget))
+                .collect(),
+        );
+        let mut grid = ChordGrid {
+            cell,
+            index: HashMap::with_hasher(FixedState::default()),
+            columns: Vec::new(),
+        };
+        let mut used = 0usize;
+        for part in built {
+            let part = part?;
+            used = used.saturating_add(part.used);
+            if used > budget {
+                return None;
+            }
+            for (key, chords) in part.columns {
+                let at = *grid.index.entry(key).or_insert_with(|| {
+                    grid.columns.push(Column::default());
+                    (grid.columns.len() - 1) as u32
+                });
+                let column = &mut grid.columns[at as usize].chords;
+                // The parts split the chords, not the columns: a column's chords from this
+                // part all come after those from the parts before.
+                if column.is_empty() {
+                    *column = chords;
+                } else {
+                    column.extend_from_slice(&chords);
+                }
+            }
+        }
+        crate::parallel::for_each_part(&mut grid.columns, 64, |_, columns| {
+            columns.iter_mut().for_each(Column::finish)
+        });
+        Some(grid)
+    }
+}
+
+/// The column holding point `p`, for columns `cell` mm across.
+fn column_key(cell: f64, p: DVec2) -> CellKey {
+    ((p.x / cell).floor() as i32, (p.y / cell).floor() as i32)
+}
+
+/// The columns of one part of the chords, in the order first met.
+struct GridPart {
+    columns: Vec<(CellKey, Vec<CellChord>)>,
+    /// Column insertions made.
+    used: usize,
+}
+
+impl GridPart {
+    /// Chords `range` of path `v` (those with both ends inside the machine) in their columns;
+    /// None past `budget` insertions.
+    fn build(
+        v: &[DVec3],
+        chords: &[(usize, usize)],
+        range: std::ops::Range<usize>,
+        cell: f64,
+        inside: &impl Fn(DVec3) -> bool,
+        budget: usize,
+    ) -> Option<GridPart> {
+        let mut index: HashMap<CellKey, usize, FixedState> =
+            HashMap::with_hasher(FixedState::default());
+        let mut part = GridPart {
+            columns: Vec::new(),
+            used: 0,
+        };
+        // Consecutive chords mostly fall in the column of the one before.
+        let mut last: Option<(CellKey, usize)> = None;
+        for id in range {
+            let (ia, ib) = chords[id];
+            let (a, b) = (v[ia], v[ib]);
+            if !(inside(a) && inside(b)) {
+                continue;
+            }
+            part.insert(id as u32, ib, a, b, cell, budget, &mut index, &mut last)?;
+        }
+        Some(part)
     }
 
     /// Registers chord `id` from `a` to `b` in every column it passes: the chord is cut into
-    /// pieces no longer than a cell and each piece's box of cells is marked. A steep chord
+    /// pieces no longer than a cell and each piece's box of columns is marked. A steep chord
     /// (rising more than it runs) is a step between layers that no point rests on, and is left
-    /// out. False when the insertion budget is spent.
-    fn insert(&mut self, id: u32, end: usize, a: DVec3, b: DVec3) -> bool {
+    /// out. None when the insertion budget is spent.
+    #[allow(clippy::too_many_arguments)]
+    fn insert(
+        &mut self,
+        id: u32,
+        end: usize,
+        a: DVec3,
+        b: DVec3,
+        cell: f64,
+        budget: usize,
+        index: &mut HashMap<CellKey, usize, FixedState>,
+        last: &mut Option<(CellKey, usize)>,
+    ) -> Option<()> {
         let d = b - a;
         if d.z * d.z > d.truncate().length_squared() {
-            return true;
+            return Some(());
         }
         let chord = CellChord::new(id, end, a, b);
-        let steps = (d.truncate().abs().max_element() / self.cell).ceil().max(1.0);
-        if steps > self.budget as f64 {
-            self.budget = 0;
-            return false;
+        let steps = (d.truncate().abs().max_element() / cell).ceil().max(1.0);
+        if steps > budget.saturating_sub(self.used) as f64 {
+            return None;
         }
         let steps = steps as usize;
         for s in 0..steps {
@@ -222,22 +325,33 @@ impl ChordGrid {
                 a.truncate() + d.truncate() * (s as f64 / steps as f64),
                 a.truncate() + d.truncate() * ((s + 1) as f64 / steps as f64),
             );
-            let (k0, k1) = (self.key(p.min(q)), self.key(p.max(q)));
+            let (k0, k1) = (column_key(cell, p.min(q)), column_key(cell, p.max(q)));
             for x in k0.0..=k1.0 {
                 for y in k0.1..=k1.1 {
-                    if self.budget == 0 {
-                        return false;
+                    if self.used >= budget {
+                        return None;
                     }
-                    self.budget -= 1;
-                    let column = &mut self.columns.entry((x, y)).or_default().chords;
-                    // Neighbouring pieces share cells: each column holds a chord once.
+                    self.used += 1;
+                    let at = match *last {
+                        Some((key, at)) if key == (x, y) => at,
+                        _ => {
+                            let at = *index.entry((x, y)).or_insert_with(|| {
+                                self.columns.push(((x, y), Vec::new()));
+                                self.columns.len() - 1
+                            });
+                            *last = Some(((x, y), at));
+                            at
+                        }
+                    };
+                    let column = &mut self.columns[at].1;
+                    // Neighbouring pieces share columns: each column holds a chord once.
                     if column.last().is_none_or(|c| c.id != id) {
                         column.push(chord);
                     }
                 }
             }
         }
-        true
+        Some(())
     }
 }
 
@@ -327,25 +441,23 @@ fn measure_layers_in(
     };
     let chords = chords(v);
     // Columns twice the near box's half-width across: a point's near box spans 2 × 2 of them
-    // mostly.
-    let mut grid = ChordGrid {
+    // mostly. Every chord goes into the grid first; a point's candidates are the chords that
+    // end at or before it (a prefix of each column's ascending list), so the points can be
+    // searched in any order, on every core.
+    let grid = ChordGrid::build(
+        v,
+        &chords,
+        2.0 * near_radius,
+        &inside,
+        INSERTIONS_BASE.saturating_add(INSERTIONS_PER_CHORD.saturating_mul(chords.len())),
+        20_000,
+    );
+    let mut measurable = grid.is_some();
+    let grid = grid.unwrap_or_else(|| ChordGrid {
         cell: 2.0 * near_radius,
-        columns: HashMap::with_hasher(FixedState::default()),
-        budget: INSERTIONS_BASE.saturating_add(INSERTIONS_PER_CHORD.saturating_mul(chords.len())),
-    };
-    // Every chord goes into the grid first; a point's candidates are the chords that end at or
-    // before it (a prefix of each column's ascending list), so the points can be searched in any
-    // order, on every core.
-    let mut measurable = true;
-    for (id, &(ia, ib)) in chords.iter().enumerate() {
-        let (a, b) = (v[ia], v[ib]);
-        if measurable && inside(a) && inside(b) {
-            measurable = grid.insert(id as u32, ib, a, b);
-        }
-    }
-    for column in grid.columns.values_mut() {
-        column.finish();
-    }
+        index: HashMap::with_hasher(FixedState::default()),
+        columns: Vec::new(),
+    });
     let mut cum = vec![0.0; v.len()];
     for j in 1..v.len() {
         cum[j] = cum[j - 1] + v[j - 1].distance(v[j]);
@@ -524,8 +636,9 @@ impl<'g> NearColumns<'g> {
             self.columns.clear();
             for x in lo.0..=hi.0 {
                 for y in lo.1..=hi.1 {
-                    if let Some(column) = grid.columns.get(&(x, y)) {
-                        self.columns.push((column, Run::default()));
+                    if let Some(&at) = grid.index.get(&(x, y)) {
+                        self.columns
+                            .push((&grid.columns[at as usize], Run::default()));
                     }
                 }
             }
@@ -883,7 +996,11 @@ mod tests {
                 let t = i as f64 / per_turn;
                 let a = t * std::f64::consts::TAU + ring as f64;
                 let r = r + jitter[i % jitter.len()];
-                v.push(DVec3::new(100.0 + r * a.cos(), 100.0 + r * a.sin(), z0 + 0.5 * t));
+                v.push(DVec3::new(
+                    100.0 + r * a.cos(),
+                    100.0 + r * a.sin(),
+                    z0 + 0.5 * t,
+                ));
             }
         }
         v
@@ -939,6 +1056,48 @@ mod tests {
             let short2 = short_chord2(2000.0 + 2.0 * radius + 10.0, radius);
             prop_assert!(c.may_be_under([p.x as f32, p.y as f32], z, short2));
         }
+    }
+
+    /// The grid built in parts on both cores is the grid built on one: the same columns, each
+    /// with the same chords in path order and the same height bounds; and past its budget
+    /// (counted over all parts) it gives up alike.
+    #[test]
+    fn the_grid_in_parts_is_the_grid_in_one() {
+        let v = wobbly_spiral(2.0, 1.5, 5.0, &[0.0, 0.3, -0.2]);
+        let chords = chords(&v);
+        let inside = |p: DVec3| p.x > 120.0; // some chords outside the machine
+        let columns = |g: &ChordGrid| {
+            let mut c: Vec<_> = g
+                .index
+                .iter()
+                .map(|(k, &at)| {
+                    let col = &g.columns[at as usize];
+                    let ids: Vec<u32> = col.chords.iter().map(|c| c.id).collect();
+                    (*k, ids, col.top.clone(), col.bottom.clone())
+                })
+                .collect();
+            c.sort_by_key(|x| x.0);
+            c
+        };
+        let one = ChordGrid::build(&v, &chords, 2.5, &inside, usize::MAX, usize::MAX).unwrap();
+        let parts = ChordGrid::build(&v, &chords, 2.5, &inside, usize::MAX, 100).unwrap();
+        assert!(one.columns.len() > 20);
+        assert_eq!(columns(&one), columns(&parts));
+        // The least budget that one part needs is the least that two need.
+        let build = |budget, serial_below| {
+            ChordGrid::build(&v, &chords, 2.5, &inside, budget, serial_below).is_some()
+        };
+        let (mut lo, mut hi) = (0, 64 * chords.len());
+        while lo + 1 < hi {
+            let mid = (lo + hi) / 2;
+            if build(mid, usize::MAX) {
+                hi = mid
+            } else {
+                lo = mid
+            }
+        }
+        assert!(hi > one.columns.iter().map(|c| c.chords.len()).sum::<usize>() / 2);
+        assert!(build(hi, 100) && !build(hi - 1, 100));
     }
 
     #[test]
