@@ -33,13 +33,13 @@ const CANDIDATES_PER_POINT: usize = 1024;
 const CANDIDATES_BASE: usize = 1 << 24;
 
 /// A grid column: (x, y) cell indices.
-type CellKey = (i32, i32);
+type ColumnKey = (i32, i32);
 
-/// A chord as a cell keeps it: its id and last point, and its ends in single precision with its
+/// A chord as a column keeps it: its id and last point, and its ends in single precision with its
 /// heights rounded outward, enough to reject most candidates without reading the path (a point's
 /// box holds about a hundred chords, of which one in seven is under it).
 #[derive(Clone, Copy)]
-struct CellChord {
+struct ColumnChord {
     id: u32,
     /// The chord's last point (it is a candidate for points from there on).
     end: u32,
@@ -50,7 +50,7 @@ struct CellChord {
     b: [f32; 2],
 }
 
-impl CellChord {
+impl ColumnChord {
     fn new(id: u32, end: usize, a: DVec3, b: DVec3) -> Self {
         Self {
             id,
@@ -104,7 +104,7 @@ fn short_chord2(extent: f64, radius: f64) -> f32 {
 /// the column; on any other path it leaves at least the chords the height test keeps.
 #[derive(Default)]
 struct Column {
-    chords: Vec<CellChord>,
+    chords: Vec<ColumnChord>,
     top: Vec<f32>,
     bottom: Vec<f32>,
 }
@@ -136,7 +136,7 @@ impl Column {
     /// heights `z` (low, high): found from the run of the last search when there is one (a few
     /// steps for the next point of a path, bisection after a jump), else by bisection.
     fn run(&self, j: usize, z: [f32; 2], from: Option<Run>) -> Run {
-        let laid = |c: &CellChord| c.end as usize <= j;
+        let laid = |c: &ColumnChord| c.end as usize <= j;
         let below = |&t: &f32| t < z[0];
         let not_above = |&b: &f32| b <= z[1];
         match from {
@@ -189,12 +189,12 @@ fn seek<T>(v: &[T], guess: usize, pred: impl Fn(&T) -> bool) -> usize {
 struct ChordGrid {
     cell: f64,
     /// Each column's place in `columns`.
-    index: HashMap<CellKey, u32, FixedState>,
+    index: HashMap<ColumnKey, u32, FixedState>,
     columns: Vec<Column>,
 }
 
 impl ChordGrid {
-    fn key(&self, p: DVec2) -> CellKey {
+    fn key(&self, p: DVec2) -> ColumnKey {
         column_key(self.cell, p)
     }
 
@@ -253,13 +253,13 @@ impl ChordGrid {
 }
 
 /// The column holding point `p`, for columns `cell` mm across.
-fn column_key(cell: f64, p: DVec2) -> CellKey {
+fn column_key(cell: f64, p: DVec2) -> ColumnKey {
     ((p.x / cell).floor() as i32, (p.y / cell).floor() as i32)
 }
 
 /// The columns of one part of the chords, in the order first met.
 struct GridPart {
-    columns: Vec<(CellKey, Vec<CellChord>)>,
+    columns: Vec<(ColumnKey, Vec<ColumnChord>)>,
     /// Column insertions made.
     used: usize,
 }
@@ -275,14 +275,14 @@ impl GridPart {
         inside: &impl Fn(DVec3) -> bool,
         budget: usize,
     ) -> Option<GridPart> {
-        let mut index: HashMap<CellKey, usize, FixedState> =
+        let mut index: HashMap<ColumnKey, usize, FixedState> =
             HashMap::with_hasher(FixedState::default());
         let mut part = GridPart {
             columns: Vec::new(),
             used: 0,
         };
         // Consecutive chords mostly fall in the column of the one before.
-        let mut last: Option<(CellKey, usize)> = None;
+        let mut last: Option<(ColumnKey, usize)> = None;
         for id in range {
             let (ia, ib) = chords[id];
             let (a, b) = (v[ia], v[ib]);
@@ -307,14 +307,14 @@ impl GridPart {
         b: DVec3,
         cell: f64,
         budget: usize,
-        index: &mut HashMap<CellKey, usize, FixedState>,
-        last: &mut Option<(CellKey, usize)>,
+        index: &mut HashMap<ColumnKey, usize, FixedState>,
+        last: &mut Option<(ColumnKey, usize)>,
     ) -> Option<()> {
         let d = b - a;
         if d.z * d.z > d.truncate().length_squared() {
             return Some(());
         }
-        let chord = CellChord::new(id, end, a, b);
+        let chord = ColumnChord::new(id, end, a, b);
         let steps = (d.truncate().abs().max_element() / cell).ceil().max(1.0);
         if steps > budget.saturating_sub(self.used) as f64 {
             return None;
@@ -615,7 +615,7 @@ fn measure_layers_in(
 /// columns are looked up again only when the box moves; the runs move a few chords a point).
 #[derive(Default)]
 struct NearColumns<'g> {
-    bounds: Option<(CellKey, CellKey)>,
+    bounds: Option<(ColumnKey, ColumnKey)>,
     columns: Vec<(&'g Column, Run)>,
     /// Whether the runs are those of the previous point (false for a box just looked up).
     stepped: bool,
@@ -626,8 +626,8 @@ impl<'g> NearColumns<'g> {
     fn update(
         &mut self,
         grid: &'g ChordGrid,
-        lo: CellKey,
-        hi: CellKey,
+        lo: ColumnKey,
+        hi: ColumnKey,
         j: usize,
         z: [f32; 2],
     ) -> &[(&'g Column, Run)] {
@@ -1051,7 +1051,7 @@ mod tests {
             let exact = (p - a.truncate()).dot(b.truncate() - a.truncate()) / (len * len);
             // At the ends of the range the exact fraction may round just outside it: skipped.
             prop_assume!((-0.5..=1.5).contains(&exact));
-            let c = CellChord::new(0, 1, a, b);
+            let c = ColumnChord::new(0, 1, a, b);
             let z = [(az - 1.0) as f32, (az + 1.0) as f32];
             let short2 = short_chord2(2000.0 + 2.0 * radius + 10.0, radius);
             prop_assert!(c.may_be_under([p.x as f32, p.y as f32], z, short2));
