@@ -27,8 +27,8 @@ const INSERTIONS_PER_CHORD: usize = 64;
 const INSERTIONS_BASE: usize = 1 << 22;
 /// Candidate chords examined in all: a fixed allowance plus this many per point. The 720 × 300
 /// benchmark vase examines 96 per point on average (more at the centre of its spiral base); a file that
-/// piles its whole path onto one spot (no clay print) runs out of budget and is reported as not
-/// measurable instead of being searched in quadratic time.
+/// piles its whole path onto one spot, rising (no clay print), runs out of budget and is reported
+/// as not measurable instead of being searched in quadratic time.
 const CANDIDATES_PER_POINT: usize = 1024;
 const CANDIDATES_BASE: usize = 1 << 24;
 

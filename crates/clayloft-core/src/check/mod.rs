@@ -325,6 +325,19 @@ mod tests {
         }
         let r = check_gcode(&spot, &limits()).unwrap();
         assert!(r.violations.iter().any(|v| v.what == NOT_MEASURED), "{r}");
+        // The same zig-zag at one height on the bed: no chord is within a layer's reach below
+        // any point, so none is a candidate and every point rests on the bed (the search by
+        // 3-D cells spent its budget on them and called the file not measurable).
+        let flat = spot
+            .lines()
+            .map(|l| match l.find(" Z") {
+                Some(at) => format!("{} Z0.5 E0.01\n", &l[..at]),
+                None => format!("{l}\n"),
+            })
+            .collect::<String>();
+        let r = check_gcode(&flat, &limits()).unwrap();
+        assert!(r.ok(), "{r}");
+        assert_eq!((r.min_layer_height, r.max_layer_height), (0.5, 0.5));
         // Relative moves that run past every finite number.
         let e = check_gcode("G91\nG1 X1e308 E1\nG1 X1e308 E1\n", &limits()).unwrap_err();
         assert!(e.message.contains("finite"), "{e}");
