@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use clayloft_core::check::{Limits, check_gcode};
+use clayloft_core::check::{Limits, check_gcode, verify_gcode};
 // The batch commands keep the helper threads spinning from start to end: their stages follow
 // each other closely (see `clayloft_core::parallel`).
 use clayloft_core::gcode::{JobSummary, format_duration, summarize, write_gcode_summarized};
@@ -384,8 +384,8 @@ fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, F
         // design that still breaks a limit on this printer is refused with what broke.
         let report = std::str::from_utf8(&text)
             .map_err(|_| Failure("the G-code writer made non-text".into()))
-            .and_then(|t| check_gcode(t, &Limits::from(&d.printer)).map_err(Failure::from))?;
-        if let Some(v) = report.violations.first() {
+            .and_then(|t| verify_gcode(t, &Limits::from(&d.printer)).map_err(Failure::from))?;
+        if let Some(v) = report.as_ref().and_then(|r| r.violations.first()) {
             return Err(Failure(format!(
                 "{}: does not print on this printer ({}): {} at {} points, worst {:.2} ({}); try a printer with a finer bead or thinner layers, or a simpler contour",
                 loaded.path.display(),

@@ -78,8 +78,9 @@ fn pipeline(c: &mut Criterion) {
         b.iter(|| black_box(clayloft_core::printability::droops(&design, &job.surface).unwrap()))
     });
     g.finish();
-    // The self-check `clayloft gcode` runs on its own file before writing it: parse, then the
-    // layer search (every point against the chords of the layers below).
+    // The checker (`clayloft check`): parse, then the layer search (every point against the
+    // chords of the layers below); and the self-check `clayloft gcode` runs on its own file
+    // before writing it, the layers shown by witnesses.
     let mut text = Vec::new();
     write_gcode(&design, &job, &mut text).unwrap();
     let text = String::from_utf8(text).unwrap();
@@ -94,6 +95,15 @@ fn pipeline(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("check_gcode_720x300", |b| {
         b.iter(|| black_box(clayloft_core::check::check_gcode(&text, &limits).unwrap()))
+    });
+    g.bench_function("verify_gcode_720x300", |b| {
+        b.iter(|| {
+            assert!(
+                clayloft_core::check::verify_gcode(&text, &limits)
+                    .unwrap()
+                    .is_none()
+            )
+        })
     });
     // Of that, reading the file's moves.
     g.bench_function("parse_gcode_720x300", |b| {

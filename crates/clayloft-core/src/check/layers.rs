@@ -394,7 +394,21 @@ pub(super) fn measure_layers(
     limits: &Limits,
     report: &mut CheckReport,
 ) {
-    measure_layers_in(v, lines, limits, report, Search::NearFirst)
+    measure_layers_in(v, lines, limits, report, Search::NearFirst, false);
+}
+
+/// Whether the layers of `v` keep `limits`, shown point by point without measuring each in full
+/// where a witness shows it (see [`LayerSearch::proves`]): true when shown for every point, and
+/// then `report` holds the path's length and the holder's clearance only, not the layers'
+/// figures; false when not (a limit broken, or the search's budget spent), and then `report` is
+/// [`measure_layers`]'s.
+pub(super) fn layers_hold(
+    v: &[DVec3],
+    lines: &[usize],
+    limits: &Limits,
+    report: &mut CheckReport,
+) -> bool {
+    measure_layers_in(v, lines, limits, report, Search::NearFirst, true)
 }
 
 /// How [`measure_layers_in`] searches: all three give the same report (tested; the checker
@@ -410,14 +424,15 @@ enum Search {
     EveryChord,
 }
 
-/// [`measure_layers`], searched as `search` says.
+/// [`measure_layers`], searched as `search` says; with `first_show`, [`layers_hold`].
 fn measure_layers_in(
     v: &[DVec3],
     lines: &[usize],
     limits: &Limits,
     report: &mut CheckReport,
     search: Search,
-) {
+    first_show: bool,
+) -> bool {
     let tan_max = limits.max_overhang_deg.to_radians().tan();
     let radius = limits.line_width + 2.0 * limits.max_layer_height * tan_max;
     let gap = 3.0 * radius;
@@ -482,8 +497,13 @@ fn measure_layers_in(
         inside: &inside,
         every_chord: search == Search::EveryChord,
     };
-    let below: Vec<Below> = if measurable {
-        search.all(CANDIDATES_BASE.saturating_add(CANDIDATES_PER_POINT.saturating_mul(v.len())))
+    let layer_limits = LayerLimits::of(limits);
+    let budget = CANDIDATES_BASE.saturating_add(CANDIDATES_PER_POINT.saturating_mul(v.len()));
+    let shown = first_show && measurable && search.proves_all(budget, layer_limits);
+    let below: Vec<Below> = if shown {
+        vec![Below::Skipped; v.len()]
+    } else if measurable {
+        search.all(budget)
     } else {
         Vec::new()
     };
@@ -496,11 +516,6 @@ fn measure_layers_in(
     );
     report.min_layer_height = f64::INFINITY;
     let mut running_max_z = f64::NEG_INFINITY;
-    let layer_tol = 0.01 * limits.max_layer_height + 0.002;
-    // Degrees: G-code coordinates are rounded to 1 µm and the lean is measured against polyline
-    // segments; the seam step where the helix leaves the flat revolution leans up to ~2° more
-    // than the sections around it for one point.
-    let angle_tol = 2.0;
     for j in 0..v.len() {
         let p = v[j];
         if running_max_z - p.z > report.max_rise_above_tip {
@@ -537,14 +552,14 @@ fn measure_layers_in(
         };
         report.min_layer_height = report.min_layer_height.min(height);
         report.max_layer_height = report.max_layer_height.max(height);
-        if height < limits.min_layer_height - layer_tol {
+        if layer_limits.too_thin(height) {
             thin.add(limits.min_layer_height - height, lines[j]);
         }
-        if height > limits.max_layer_height + layer_tol {
+        if layer_limits.too_thick(height) {
             thick.add(height - limits.max_layer_height, lines[j]);
         }
         report.max_overhang_deg = report.max_overhang_deg.max(angle);
-        if angle > limits.max_overhang_deg + angle_tol {
+        if layer_limits.leans_too_far(angle) {
             lean.add(angle, lines[j]);
             report.events.push(PathEvent {
                 line: lines[j],
@@ -609,6 +624,7 @@ fn measure_layers_in(
             limits.nozzle_length
         ),
     );
+    shown
 }
 
 /// The grid columns around the last point searched, each with its run for that point (the
@@ -652,6 +668,53 @@ impl<'g> NearColumns<'g> {
     }
 }
 
+/// The limits a point's layer keeps, with the tolerances the checker allows them.
+#[derive(Debug, Clone, Copy)]
+struct LayerLimits {
+    min_height: f64,
+    max_height: f64,
+    /// mm either way: the 1 µm rounding of G-code coordinates, and 1 % of the range.
+    height_tol: f64,
+    /// Degrees from vertical, tolerance included: G-code coordinates are rounded to 1 µm and
+    /// the lean is measured against polyline segments; the seam step where the helix leaves
+    /// the flat revolution leans up to ~2° more than the sections around it for one point.
+    max_lean_deg: f64,
+}
+
+impl LayerLimits {
+    fn of(limits: &Limits) -> Self {
+        LayerLimits {
+            min_height: limits.min_layer_height,
+            max_height: limits.max_layer_height,
+            height_tol: 0.01 * limits.max_layer_height + 0.002,
+            max_lean_deg: limits.max_overhang_deg + 2.0,
+        }
+    }
+
+    fn too_thin(&self, height: f64) -> bool {
+        height < self.min_height - self.height_tol
+    }
+
+    fn too_thick(&self, height: f64) -> bool {
+        height > self.max_height + self.height_tol
+    }
+
+    fn leans_too_far(&self, lean_deg: f64) -> bool {
+        lean_deg > self.max_lean_deg
+    }
+
+    /// Whether what lies below a point breaks a limit (or was not measured).
+    fn broken_by(&self, below: Below) -> bool {
+        match below {
+            Below::Skipped => false,
+            Below::Unmeasurable | Below::Unsupported => true,
+            Below::Layer { height, lean_deg } => {
+                self.too_thin(height) || self.too_thick(height) || self.leans_too_far(lean_deg)
+            }
+        }
+    }
+}
+
 /// What lies below one path point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Below {
@@ -670,8 +733,9 @@ enum Below {
 /// height `zq`, `d` across from the point in XY. Kept as running extremes, not a list.
 #[derive(Clone, Copy)]
 struct Found {
-    /// Highest spot within half a bead (the layer the point rests on).
+    /// Highest spot within half a bead (the layer the point rests on), and its chord.
     top_under: f64,
+    top_chord: usize,
     /// The spot of least lean, as d / (p.z − zq) (the tangent of the lean, which is monotone in
     /// it: one arctangent per point, not per spot).
     least_lean: Option<(f64, f64, f64)>,
@@ -682,13 +746,14 @@ struct Found {
 impl Found {
     const NONE: Found = Found {
         top_under: f64::NEG_INFINITY,
+        top_chord: usize::MAX,
         least_lean: None,
         nearest: None,
     };
 
-    fn add(&mut self, pz: f64, zq: f64, d: f64, half_bead: f64) {
-        if d <= half_bead {
-            self.top_under = self.top_under.max(zq);
+    fn add(&mut self, pz: f64, zq: f64, d: f64, half_bead: f64, chord: usize) {
+        if d <= half_bead && zq > self.top_under {
+            (self.top_under, self.top_chord) = (zq, chord);
         }
         let tan = d / (pz - zq).max(1e-9);
         if self.least_lean.is_none_or(|(t, _, _)| tan < t) {
@@ -762,6 +827,113 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         out
     }
 
+    /// Whether every point keeps `limits`, shown without measuring every point in full (see
+    /// [`LayerSearch::proves`]); on every core, each part with its share of `budget`.
+    fn proves_all(&self, budget: usize, limits: LayerLimits) -> bool {
+        let n = self.v.len();
+        let threads = crate::parallel::cores().clamp(1, 8);
+        if threads < 2 || n < 20_000 {
+            return self.proves(0..n, budget, limits);
+        }
+        let chunk = n.div_ceil(threads);
+        let share = budget / threads;
+        crate::parallel::run_parts(
+            (0..n)
+                .step_by(chunk)
+                .map(|start| move || self.proves(start..(start + chunk).min(n), share, limits))
+                .collect(),
+        )
+        .into_iter()
+        .all(|holds| holds)
+    }
+
+    /// Whether points `range` keep `limits` (the layer they rest on neither too thin nor too
+    /// thick, a lean within the limit, support): true only when shown for each; false at the
+    /// first point where it is not (a point that breaks a limit, or one this way cannot show).
+    ///
+    /// A point is shown by a witness: a spot within half a bead under it (so the layer it
+    /// rests on is at least that high, and the layer not too thick) leaning within the limit (so
+    /// the least lean is too), sought on the chords from the one under the point before; and by
+    /// the absence of any spot within half a bead higher than the thinnest layer allows (a
+    /// search of a band of heights a fifth of a layer deep, which on a rising wall holds no
+    /// chord). Where no witness is near, the point is measured in full and judged.
+    fn proves(
+        &self,
+        range: std::ops::Range<usize>,
+        mut budget: usize,
+        limits: LayerLimits,
+    ) -> bool {
+        let (mut near, mut wide, mut thin) = (
+            NearColumns::default(),
+            NearColumns::default(),
+            NearColumns::default(),
+        );
+        let mut under: Option<usize> = None;
+        for j in range {
+            let p = self.v[j];
+            if j == 0 || !(self.inside)(p) {
+                continue;
+            }
+            let witness = under.and_then(|k| {
+                [k, k + 1, k + 2, k + 3, k.wrapping_sub(1)]
+                    .into_iter()
+                    .find(|&id| self.witnesses(j, id, limits))
+            });
+            if witness.is_none() {
+                let (below, top) = self.point_found(j, &mut near, &mut wide, &mut budget);
+                if limits.broken_by(below) {
+                    return false;
+                }
+                under = top;
+                continue;
+            }
+            under = witness;
+            let heights = [
+                p.z - limits.min_height + limits.height_tol,
+                p.z - self.below_tol,
+            ];
+            match self.scan_heights(j, self.half_bead, heights, &mut thin, &mut budget) {
+                Some(found) if !found.top_under.is_finite() => {}
+                Some(_) => {
+                    // A spot as high as a thin layer: measured in full and judged.
+                    let (below, _) = self.point_found(j, &mut near, &mut wide, &mut budget);
+                    if limits.broken_by(below) {
+                        return false;
+                    }
+                }
+                None => return false,
+            }
+        }
+        true
+    }
+
+    /// Whether chord `id`'s spot under point j is a witness that j keeps `limits` (see
+    /// [`LayerSearch::proves`]): a spot as the search would find it, within half a bead, at
+    /// most the thickest layer below and leaning within the limit.
+    fn witnesses(&self, j: usize, id: usize, limits: LayerLimits) -> bool {
+        let Some(&(ia, ib)) = self.chords.get(id) else {
+            return false;
+        };
+        let (a, b) = (self.v[ia], self.v[ib]);
+        // Only chords the grid holds: laid before j, inside the machine, not steep.
+        let steep = (b.z - a.z).powi(2) > (b - a).truncate().length_squared();
+        if ib > j || steep || !(self.inside)(a) || !(self.inside)(b) {
+            return false;
+        }
+        let p = self.v[j];
+        let mut spot = Found::NONE;
+        self.add_spot(j, id, [p.z - self.reach, p.z - self.below_tol], &mut spot);
+        let Some((_, d, z)) = spot.least_lean else {
+            return false;
+        };
+        spot.top_under.is_finite()
+            && !limits.too_thick(p.z - spot.top_under)
+            && !limits.too_thin(p.z - spot.top_under)
+            // The least lean is at most this one's (its tangent is); a hair of margin for the
+            // arctangent's rounding.
+            && d.atan2((p.z - z).max(1e-9)).to_degrees() < limits.max_lean_deg - 1e-9
+    }
+
     /// The topmost earlier layer below point j within the search radius, and the least lean
     /// from the layers below within reach.
     ///
@@ -778,28 +950,50 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         wide: &mut NearColumns<'g>,
         budget: &mut usize,
     ) -> Below {
+        self.point_found(j, near, wide, budget).0
+    }
+
+    /// [`LayerSearch::point`], and the chord of the layer it rests on (if it rests on one).
+    fn point_found<'g>(
+        &'g self,
+        j: usize,
+        near: &mut NearColumns<'g>,
+        wide: &mut NearColumns<'g>,
+        budget: &mut usize,
+    ) -> (Below, Option<usize>) {
         let p = self.v[j];
         if j == 0 || !(self.inside)(p) {
-            return Below::Skipped;
+            return (Below::Skipped, None);
         }
-        if self.every_chord {
-            return self.below(p, self.every_chord(j));
-        }
-        let mut found = match self.scan(j, self.near_radius, near, budget) {
-            Some(f) => f,
-            None => return Below::Unmeasurable,
+        let found = if self.every_chord {
+            self.every_chord(j)
+        } else {
+            match self.point_scans(j, near, wide, budget) {
+                Some(found) => found,
+                None => return (Below::Unmeasurable, None),
+            }
         };
+        let top = found.top_under.is_finite().then_some(found.top_chord);
+        (self.below(p, found), top)
+    }
+
+    /// The near box's spots, or the whole box's where the near box does not settle the point.
+    fn point_scans<'g>(
+        &'g self,
+        j: usize,
+        near: &mut NearColumns<'g>,
+        wide: &mut NearColumns<'g>,
+        budget: &mut usize,
+    ) -> Option<Found> {
+        let mut found = self.scan(j, self.near_radius, near, budget)?;
         let settled = found.top_under.is_finite()
             && found
                 .least_lean
                 .is_some_and(|(t, _, _)| t * self.reach < self.near_radius);
         if !settled && self.near_radius < self.radius {
-            found = match self.scan(j, self.radius, wide, budget) {
-                Some(f) => f,
-                None => return Below::Unmeasurable,
-            };
+            found = self.scan(j, self.radius, wide, budget)?;
         }
-        self.below(p, found)
+        Some(found)
     }
 
     /// What lies below point `p`, given the spots found under it.
@@ -837,10 +1031,27 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         cache: &mut NearColumns<'g>,
         budget: &mut usize,
     ) -> Option<Found> {
+        let z = self.v[j].z;
+        self.scan_heights(
+            j,
+            box_radius,
+            [z - self.reach, z - self.below_tol],
+            cache,
+            budget,
+        )
+    }
+
+    /// [`LayerSearch::scan`] for the spots at heights `z_lo ..= z_hi` only.
+    fn scan_heights<'g>(
+        &'g self,
+        j: usize,
+        box_radius: f64,
+        [z_lo, z_hi]: [f64; 2],
+        cache: &mut NearColumns<'g>,
+        budget: &mut usize,
+    ) -> Option<Found> {
         let p = self.v[j];
-        let (below_tol, reach) = (self.below_tol, self.reach);
         let pxy = p.truncate();
-        let (z_lo, z_hi) = (p.z - reach, p.z - below_tol);
         let z32 = [(z_lo as f32).next_down(), (z_hi as f32).next_up()];
         // Consecutive points mostly share their box of columns: look them up once per box.
         let columns = cache.update(
@@ -926,7 +1137,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
             return;
         }
         if zq <= z[1] && zq >= z[0] {
-            found.add(p.z, zq, d, self.half_bead);
+            found.add(p.z, zq, d, self.half_bead, id);
         }
     }
 }
@@ -970,10 +1181,29 @@ mod tests {
             let lines: Vec<usize> = (0..v.len()).collect();
             let limits = Limits::from(&Printer::default());
             let (mut near, mut whole) = (CheckReport::default(), CheckReport::default());
-            measure_layers_in(&v, &lines, &limits, &mut near, Search::NearFirst);
-            measure_layers_in(&v, &lines, &limits, &mut whole, Search::WholeBox);
+            measure_layers_in(&v, &lines, &limits, &mut near, Search::NearFirst, false);
+            measure_layers_in(&v, &lines, &limits, &mut whole, Search::WholeBox, false);
             prop_assert_eq!(&near, &whole);
         }
+    }
+
+    /// Rings stacked 0.8 mm apart, each at one height (a vertical step between them), the
+    /// first on the bed: a wall whose every point rests on the ring below, leaning as the
+    /// spiral's does.
+    fn stacked_rings(flare: f64, wobble: f64, lobes: f64, jitter: &[f64]) -> Vec<DVec3> {
+        let (per_rev, revs, h) = (180, 30, 0.8);
+        (0..per_rev * revs)
+            .map(|i| {
+                let ring = (i / per_rev) as f64;
+                let a = (i % per_rev) as f64 / per_rev as f64 * std::f64::consts::TAU;
+                let z = 0.5 + h * ring;
+                let r = 40.0
+                    + flare * z * z / 30.0
+                    + wobble * (lobes * a + 0.3 * z).sin()
+                    + jitter[i % jitter.len()];
+                DVec3::new(150.0 + r * a.cos(), 150.0 + r * a.sin(), z)
+            })
+            .collect()
     }
 
     /// A flat spiral base from the centre out, then a wall that climbs, steps back down to
@@ -1025,10 +1255,65 @@ mod tests {
             for v in [&wall[..180 * 12], &base_and_rings(turns, drop, &jitter)] {
                 let lines: Vec<usize> = (0..v.len()).collect();
                 let (mut grid, mut every) = (CheckReport::default(), CheckReport::default());
-                measure_layers_in(v, &lines, &limits, &mut grid, Search::NearFirst);
-                measure_layers_in(v, &lines, &limits, &mut every, Search::EveryChord);
+                measure_layers_in(v, &lines, &limits, &mut grid, Search::NearFirst, false);
+                measure_layers_in(v, &lines, &limits, &mut every, Search::EveryChord, false);
                 prop_assert_eq!(&grid, &every);
             }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(16))]
+        /// Shown by witnesses only where the full measurement finds no layer broken, with the
+        /// same holder clearance; and shown on walls within the limits (not a shortcut that
+        /// never fires): walls from upright to past 45°, paths that come back over themselves.
+        #[test]
+        fn the_layers_are_shown_to_hold_only_where_measuring_finds_them_holding(
+            flare in 0.0f64..4.0,
+            wobble in 0.0f64..3.0,
+            lobes in 1.0f64..9.0,
+            turns in 1.0f64..8.0,
+            drop in -0.5f64..2.0,
+            jitter in proptest::collection::vec(-0.6f64..0.6, 1..7),
+        ) {
+            let limits = Limits::from(&Printer::default());
+            for v in [
+                wobbly_spiral(flare, wobble, lobes, &jitter),
+                stacked_rings(flare, wobble, lobes, &jitter),
+                base_and_rings(turns, drop, &jitter),
+            ] {
+                let lines: Vec<usize> = (0..v.len()).collect();
+                let (mut full, mut quick) = (CheckReport::default(), CheckReport::default());
+                measure_layers_in(&v, &lines, &limits, &mut full, Search::NearFirst, false);
+                let shown = layers_hold(&v, &lines, &limits, &mut quick);
+                let broken = full.violations.iter().any(|x| x.what != COLLISION);
+                prop_assert!(!(shown && broken), "shown, but {}", full);
+                if shown {
+                    prop_assert_eq!(&quick.violations, &full.violations);
+                    prop_assert_eq!(quick.max_rise_above_tip, full.max_rise_above_tip);
+                } else {
+                    prop_assert_eq!(&quick, &full);
+                }
+            }
+        }
+    }
+
+    /// An upright and a gently leaning textured wall are shown to hold (the witnesses carry the
+    /// whole wall), and one past the limit is not.
+    #[test]
+    fn witnesses_show_walls_within_the_limits() {
+        let limits = Limits::from(&Printer::default());
+        for (flare, wobble, holds) in [(0.0, 0.0, true), (0.5, 1.0, true), (4.0, 3.0, false)] {
+            let v = stacked_rings(flare, wobble, 7.0, &[0.0, 0.2]);
+            let lines: Vec<usize> = (0..v.len()).collect();
+            let mut report = CheckReport::default();
+            let mut full = CheckReport::default();
+            measure_layers(&v, &lines, &limits, &mut full);
+            assert_eq!(
+                layers_hold(&v, &lines, &limits, &mut report),
+                holds,
+                "{flare} {wobble} {full}"
+            );
         }
     }
 
@@ -1111,6 +1396,7 @@ mod tests {
             &Limits::from(&Printer::default()),
             &mut report,
             Search::NearFirst,
+            false,
         );
         assert!(
             report.max_overhang_deg > 50.0,
