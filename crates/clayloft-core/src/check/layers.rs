@@ -820,7 +820,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
                 out.push(Below::Unmeasurable);
                 continue;
             }
-            let b = self.point(j, &mut near, &mut wide, &mut budget);
+            let (b, _) = self.point(j, &mut near, &mut wide, &mut budget);
             spent = b == Below::Unmeasurable;
             out.push(b);
         }
@@ -880,7 +880,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
                     .find(|&id| self.witnesses(j, id, limits))
             });
             if witness.is_none() {
-                let (below, top) = self.point_found(j, &mut near, &mut wide, &mut budget);
+                let (below, top) = self.point(j, &mut near, &mut wide, &mut budget);
                 if limits.broken_by(below) {
                     return false;
                 }
@@ -896,7 +896,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
                 Some(found) if !found.top_under.is_finite() => {}
                 Some(_) => {
                     // A spot as high as a thin layer: measured in full and judged.
-                    let (below, _) = self.point_found(j, &mut near, &mut wide, &mut budget);
+                    let (below, _) = self.point(j, &mut near, &mut wide, &mut budget);
                     if limits.broken_by(below) {
                         return false;
                     }
@@ -943,18 +943,9 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
     /// least lean found in the near box is already below that, nothing outside can lessen it
     /// and the answer is the one the whole box would give. Otherwise (no support near, or a
     /// lean past the limit) the whole box of half-width `radius` is searched.
+    ///
+    /// With it, the chord of the layer the point rests on (if it rests on one).
     fn point<'g>(
-        &'g self,
-        j: usize,
-        near: &mut NearColumns<'g>,
-        wide: &mut NearColumns<'g>,
-        budget: &mut usize,
-    ) -> Below {
-        self.point_found(j, near, wide, budget).0
-    }
-
-    /// [`LayerSearch::point`], and the chord of the layer it rests on (if it rests on one).
-    fn point_found<'g>(
         &'g self,
         j: usize,
         near: &mut NearColumns<'g>,
@@ -1151,12 +1142,31 @@ mod tests {
     /// A spiral wall whose radius follows `r(z)` with a wobble: leans from vertical to past the
     /// limit, steps between revolutions, a few points off the wall.
     fn wobbly_spiral(flare: f64, wobble: f64, lobes: f64, jitter: &[f64]) -> Vec<DVec3> {
-        let (per_rev, revs, h) = (180, 40, 0.8);
-        (0..per_rev * revs)
+        wall(flare, wobble, lobes, jitter, 40, false)
+    }
+
+    /// Rings stacked 0.8 mm apart, each at one height (a vertical step between them), the
+    /// first on the bed: a wall whose every point rests on the ring below, leaning as the
+    /// spiral's does.
+    fn stacked_rings(flare: f64, wobble: f64, lobes: f64, jitter: &[f64]) -> Vec<DVec3> {
+        wall(flare, wobble, lobes, jitter, 30, true)
+    }
+
+    /// `revolutions` of a wall 0.8 mm a revolution, as a helix or as `stacked` rings.
+    fn wall(
+        flare: f64,
+        wobble: f64,
+        lobes: f64,
+        jitter: &[f64],
+        revolutions: usize,
+        stacked: bool,
+    ) -> Vec<DVec3> {
+        let (per_rev, h) = (180, 0.8);
+        (0..per_rev * revolutions)
             .map(|i| {
                 let t = i as f64 / per_rev as f64;
                 let a = t * std::f64::consts::TAU;
-                let z = 0.5 + h * t;
+                let z = 0.5 + h * if stacked { t.floor() } else { t };
                 let r = 40.0
                     + flare * z * z / 30.0
                     + wobble * (lobes * a + 0.3 * z).sin()
@@ -1185,25 +1195,6 @@ mod tests {
             measure_layers_in(&v, &lines, &limits, &mut whole, Search::WholeBox, false);
             prop_assert_eq!(&near, &whole);
         }
-    }
-
-    /// Rings stacked 0.8 mm apart, each at one height (a vertical step between them), the
-    /// first on the bed: a wall whose every point rests on the ring below, leaning as the
-    /// spiral's does.
-    fn stacked_rings(flare: f64, wobble: f64, lobes: f64, jitter: &[f64]) -> Vec<DVec3> {
-        let (per_rev, revs, h) = (180, 30, 0.8);
-        (0..per_rev * revs)
-            .map(|i| {
-                let ring = (i / per_rev) as f64;
-                let a = (i % per_rev) as f64 / per_rev as f64 * std::f64::consts::TAU;
-                let z = 0.5 + h * ring;
-                let r = 40.0
-                    + flare * z * z / 30.0
-                    + wobble * (lobes * a + 0.3 * z).sin()
-                    + jitter[i % jitter.len()];
-                DVec3::new(150.0 + r * a.cos(), 150.0 + r * a.sin(), z)
-            })
-            .collect()
     }
 
     /// A flat spiral base from the centre out, then a wall that climbs, steps back down to
@@ -1236,23 +1227,35 @@ mod tests {
         v
     }
 
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(8))]
-        /// The grid, its columns' runs and the single-precision prefilters only skip chords the
-        /// exact test would reject: the report is the one of a search of every earlier chord,
-        /// on leaning walls and on paths that come back over themselves at lower heights.
-        #[test]
-        fn the_grid_search_is_the_search_of_every_chord(
+    prop_compose! {
+        /// A leaning wobbly spiral, stacked rings leaning alike, and a spiral base with rings
+        /// that come back lower down.
+        fn paths()(
             flare in 0.0f64..4.0,
             wobble in 0.0f64..3.0,
             lobes in 1.0f64..9.0,
             turns in 1.0f64..8.0,
             drop in -0.5f64..2.0,
             jitter in proptest::collection::vec(-0.6f64..0.6, 1..7),
-        ) {
+        ) -> [Vec<DVec3>; 3] {
+            [
+                wobbly_spiral(flare, wobble, lobes, &jitter),
+                stacked_rings(flare, wobble, lobes, &jitter),
+                base_and_rings(turns, drop, &jitter),
+            ]
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(8))]
+        /// The grid, its columns' runs and the single-precision prefilters only skip chords the
+        /// exact test would reject: the report is the one of a search of every earlier chord,
+        /// on leaning walls and on paths that come back over themselves at lower heights.
+        #[test]
+        fn the_grid_search_is_the_search_of_every_chord(paths in paths()) {
             let limits = Limits::from(&Printer::default());
-            let wall = wobbly_spiral(flare, wobble, lobes, &jitter);
-            for v in [&wall[..180 * 12], &base_and_rings(turns, drop, &jitter)] {
+            let [spiral, rings, base] = &paths;
+            for v in [&spiral[..180 * 12], &rings[..180 * 12], &base[..]] {
                 let lines: Vec<usize> = (0..v.len()).collect();
                 let (mut grid, mut every) = (CheckReport::default(), CheckReport::default());
                 measure_layers_in(v, &lines, &limits, &mut grid, Search::NearFirst, false);
@@ -1268,24 +1271,13 @@ mod tests {
         /// same holder clearance; and shown on walls within the limits (not a shortcut that
         /// never fires): walls from upright to past 45°, paths that come back over themselves.
         #[test]
-        fn the_layers_are_shown_to_hold_only_where_measuring_finds_them_holding(
-            flare in 0.0f64..4.0,
-            wobble in 0.0f64..3.0,
-            lobes in 1.0f64..9.0,
-            turns in 1.0f64..8.0,
-            drop in -0.5f64..2.0,
-            jitter in proptest::collection::vec(-0.6f64..0.6, 1..7),
-        ) {
+        fn the_layers_are_shown_to_hold_only_where_measuring_finds_them_holding(paths in paths()) {
             let limits = Limits::from(&Printer::default());
-            for v in [
-                wobbly_spiral(flare, wobble, lobes, &jitter),
-                stacked_rings(flare, wobble, lobes, &jitter),
-                base_and_rings(turns, drop, &jitter),
-            ] {
+            for v in &paths {
                 let lines: Vec<usize> = (0..v.len()).collect();
                 let (mut full, mut quick) = (CheckReport::default(), CheckReport::default());
-                measure_layers_in(&v, &lines, &limits, &mut full, Search::NearFirst, false);
-                let shown = layers_hold(&v, &lines, &limits, &mut quick);
+                measure_layers_in(v, &lines, &limits, &mut full, Search::NearFirst, false);
+                let shown = layers_hold(v, &lines, &limits, &mut quick);
                 let broken = full.violations.iter().any(|x| x.what != COLLISION);
                 prop_assert!(!(shown && broken), "shown, but {}", full);
                 if shown {
