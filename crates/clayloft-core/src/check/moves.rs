@@ -238,10 +238,75 @@ fn words_of(raw: &str) -> Option<(&str, [Option<&str>; 4])> {
     (!numbered).then_some((cmd, letters))
 }
 
+/// A move in the form the G-code writer gives every path point (`G1 X… Y… Z… E… F…`: upper
+/// case, one space before each word, plain decimals of at most 15 digits, each letter at most
+/// once, nothing else on the line), read in one pass over its bytes: the X, Y, Z and E given
+/// (NaN where not given), each the value [`crate::decimal::parse_f64`] gives (m / 10^k, one
+/// division). None for any other line, which [`words_of`] reads (tested: both read alike).
+fn plain_move(raw: &[u8]) -> Option<[f64; 4]> {
+    let rest = raw
+        .strip_prefix(b"G1")
+        .or_else(|| raw.strip_prefix(b"G0"))?;
+    let mut given = [f64::NAN; 5];
+    let mut seen = [false; 5];
+    let mut i = 0;
+    while i < rest.len() {
+        if rest[i] != b' ' {
+            return None;
+        }
+        let slot = match rest.get(i + 1)? {
+            b'X' => 0,
+            b'Y' => 1,
+            b'Z' => 2,
+            b'E' => 3,
+            b'F' => 4,
+            _ => return None,
+        };
+        if std::mem::replace(&mut seen[slot], true) {
+            return None;
+        }
+        i += 2;
+        let negative = rest.get(i) == Some(&b'-');
+        i += usize::from(negative);
+        let (mut m, mut digits, mut after_point, mut point) = (0u64, 0usize, 0usize, false);
+        while let Some(&b) = rest.get(i) {
+            match b {
+                b'0'..=b'9' => {
+                    m = m * 10 + u64::from(b - b'0');
+                    digits += 1;
+                    after_point += usize::from(point);
+                }
+                b'.' if !point => point = true,
+                b' ' => break,
+                _ => return None,
+            }
+            i += 1;
+            if digits > 15 {
+                return None;
+            }
+        }
+        if digits == 0 {
+            return None;
+        }
+        // Below 10^15 < 2^53, after at most 15 digits: exact, one rounding (see parse_f64).
+        let v = m as f64 / crate::decimal::EXACT_POWERS[after_point];
+        given[slot] = if negative { -v } else { v };
+    }
+    (!rest.is_empty()).then_some([given[0], given[1], given[2], given[3]])
+}
+
 fn read_lines(text: &str, part: &mut Part) -> Result<(), GcodeError> {
     for (idx, raw) in text.lines().enumerate() {
         let line = idx + 1;
         part.lines = line;
+        if let Some([x, y, z, e]) = plain_move(raw.as_bytes()) {
+            part.moves.push(Move {
+                to: DVec3::new(x, y, z),
+                de: e,
+                line,
+            });
+            continue;
+        }
         let Some((cmd, letters)) = words_of(raw) else {
             continue;
         };
@@ -458,6 +523,18 @@ mod tests {
                 l
             }),
             1 => prop_oneof![Just("G90"), Just("G91"), Just("M82"), Just("M83"), Just("G28"), Just("G92 E0"), Just("G92 X1 Z2"), Just("N7 G1 X1 E1*42 ; numbered"), Just("; a comment"), Just(""), Just("SET_PRINT_STATS_INFO CURRENT_LAYER=3"), Just("M117 Xhello")].prop_map(String::from),
+            // The writer's own form, and lines a hair away from it (the general reader's).
+            4 => (-500.0f64..500.0, -500.0f64..500.0, 0.0f64..400.0, -2.0f64..2.0, 0u8..8).prop_map(|(x, y, z, e, var)| match var {
+                0 => format!("G1 X{x:.3} Y{y:.3} Z{z:.3} E{e:.5}"),
+                1 => format!("G1 X{x:.3} Y{y:.3} Z{z:.3} E{e:.5} F{:.1}", z * 10.0),
+                2 => format!("G0 X{x:.3} Y{y:.3}"),
+                3 => format!("G1 X{x:.3} Y{y:.3} X{z:.3} E{e:.5}"),
+                4 => format!("G1 X{x:.3}  Y{y:.3} Z{z:.3} "),
+                5 => format!("G1 X{x:.15} Y{y:.20} E{:.1}", e * 1e14),
+                6 => format!("G1 X{x:.0}. Y.{:.0} Z-{z} E-", y.abs()),
+                _ => format!("G1 X{x:.3} Y{y:.3};c F1"),
+            }),
+            1 => prop_oneof![Just("G1"), Just("G1 "), Just("G1 X"), Just("G1 X-"), Just("G1 X."), Just("G1 X1.2.3"), Just("G1 Q1"), Just("G1\tX1"), Just("G1 X1\rY2"), Just("G10 X1"), Just("G1 F"), Just("G1 Fx X2")].prop_map(String::from),
             1 => prop_oneof![Just("G1 Xhello"), Just("G92 Ebad"), Just("frobnicate"), Just("G20"), Just("G1 X1e400"), Just("G91\nG1 X1e308\nG1 X1e308")].prop_map(String::from),
         ]
     }
