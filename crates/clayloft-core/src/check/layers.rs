@@ -261,7 +261,19 @@ fn steep(a: DVec3, b: DVec3) -> bool {
 
 /// The column holding point `p`, for columns `cell` mm across.
 fn column_key(cell: f64, p: DVec2) -> ColumnKey {
-    ((p.x / cell).floor() as i32, (p.y / cell).floor() as i32)
+    (floor_i32(p.x / cell), floor_i32(p.y / cell))
+}
+
+/// `q.floor() as i32` (saturating, NaN to 0), without a call to the C library's `floor`
+/// (the default x86-64 target has no rounding instruction): truncation, one less for a
+/// negative fraction.
+fn floor_i32(q: f64) -> i32 {
+    let t = q as i32;
+    if f64::from(t) > q {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
 }
 
 /// The columns of one part of the chords, in the order first met.
@@ -636,12 +648,15 @@ fn measure_layers_in(
 
 /// The grid columns around the last point searched, each with its run for that point (the
 /// columns are looked up again only when the box moves; the runs move a few chords a point).
+/// A column's run is also kept after the box leaves it: the path comes back to the column a
+/// layer higher, and the run has moved by the chords of one layer, a few steps from it.
 #[derive(Default)]
 struct NearColumns<'g> {
     bounds: Option<(ColumnKey, ColumnKey)>,
-    columns: Vec<(&'g Column, Run)>,
-    /// Whether the runs are those of the previous point (false for a box just looked up).
-    stepped: bool,
+    /// The box's columns: each with its run and its place in the grid.
+    columns: Vec<(&'g Column, Run, u32)>,
+    /// Each grid column's last run, by its place in the grid (empty until first needed).
+    last: Vec<Option<Run>>,
 }
 
 impl<'g> NearColumns<'g> {
@@ -653,24 +668,30 @@ impl<'g> NearColumns<'g> {
         hi: ColumnKey,
         j: usize,
         z: [f32; 2],
-    ) -> &[(&'g Column, Run)] {
+    ) -> &[(&'g Column, Run, u32)] {
         if self.bounds != Some((lo, hi)) {
             self.bounds = Some((lo, hi));
+            if self.last.len() != grid.columns.len() {
+                self.last = vec![None; grid.columns.len()];
+            }
+            for &(_, run, at) in &self.columns {
+                self.last[at as usize] = Some(run);
+            }
             self.columns.clear();
             for x in lo.0..=hi.0 {
                 for y in lo.1..=hi.1 {
                     if let Some(&at) = grid.index.get(&(x, y)) {
-                        self.columns
-                            .push((&grid.columns[at as usize], Run::default()));
+                        let column = &grid.columns[at as usize];
+                        let run = column.run(j, z, self.last[at as usize]);
+                        self.columns.push((column, run, at));
                     }
                 }
             }
-            self.stepped = false;
+            return &self.columns;
         }
-        for (column, run) in &mut self.columns {
-            *run = column.run(j, z, self.stepped.then_some(*run));
+        for (column, run, _) in &mut self.columns {
+            *run = column.run(j, z, Some(*run));
         }
-        self.stepped = true;
         &self.columns
     }
 }
@@ -686,6 +707,10 @@ struct LayerLimits {
     /// the lean is measured against polyline segments; the seam step where the helix leaves
     /// the flat revolution leans up to ~2° more than the sections around it for one point.
     max_lean_deg: f64,
+    /// A lean whose tangent is below this is surely within `max_lean_deg` (a millionth of a
+    /// degree to spare for the rounding of the tangent): the witness's test, without an
+    /// arctangent per point.
+    surely_within_tan: f64,
 }
 
 impl LayerLimits {
@@ -695,6 +720,18 @@ impl LayerLimits {
             max_height: limits.max_layer_height,
             height_tol: 0.01 * limits.max_layer_height + 0.002,
             max_lean_deg: limits.max_overhang_deg + 2.0,
+            surely_within_tan: Self::tan_below(limits.max_overhang_deg + 2.0),
+        }
+    }
+
+    /// The tangent of a millionth of a degree less than `lean_deg` (infinite from 90°: every
+    /// lean of a spot below a point is less).
+    fn tan_below(lean_deg: f64) -> f64 {
+        let deg = lean_deg - 1e-6;
+        if deg >= 90.0 {
+            f64::INFINITY
+        } else {
+            deg.max(0.0).to_radians().tan()
         }
     }
 
@@ -930,9 +967,8 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         };
         spot.top_under.is_finite()
             && !limits.too_thick(p.z - spot.top_under)
-            // The least lean is at most this one's (its tangent is); a hair of margin for the
-            // arctangent's rounding.
-            && d.atan2((p.z - z).max(1e-9)).to_degrees() < limits.max_lean_deg - 1e-9
+            // The least lean is at most this one's (its tangent is).
+            && d < (p.z - z).max(1e-9) * limits.surely_within_tan
     }
 
     /// The topmost earlier layer below point j within the search radius, and the least lean
@@ -1055,7 +1091,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         );
         let p32 = [pxy.x as f32, pxy.y as f32];
         let mut found = Found::NONE;
-        for (column, run) in columns {
+        for (column, run, _) in columns {
             // The chords laid before p that may reach its layers.
             let cell = &column.chords[run.range()];
             if cell.len() > *budget {
@@ -1289,6 +1325,33 @@ mod tests {
                     prop_assert_eq!(&quick, &full);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn floor_without_the_library() {
+        for q in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.999,
+            -2.999,
+            1e9,
+            -1e9,
+            3e9,
+            -3e9,
+            -2147483648.5,
+            2147483647.5,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            1e-300,
+            -1e-300,
+        ] {
+            assert_eq!(floor_i32(q), q.floor() as i32, "{q}");
         }
     }
 
