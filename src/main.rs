@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use clayloft_core::check::{Limits, check_gcode, verify_gcode};
+use clayloft_core::check::{GcodeVerifier, Limits, check_gcode};
 // The batch commands keep the helper threads spinning from start to end: their stages follow
 // each other closely (see `clayloft_core::parallel`).
 use clayloft_core::gcode::{JobSummary, format_duration, summarize, write_gcode_summarized};
@@ -376,16 +376,31 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
 
 fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
     let (loaded, job) = job_of(design, printer)?;
-    let mut text = Vec::with_capacity(job.toolpath.points.len() * 40 + 65_536);
-    let summary = write_gcode_summarized(&loaded.design, &job, &mut text)?;
     let d = &loaded.design;
-    if d.constraints.enforce {
-        // Right first time: the file is re-measured by the checker before it is written; a
-        // design that still breaks a limit on this printer is refused with what broke.
-        let report = std::str::from_utf8(&text)
-            .map_err(|_| Failure("the G-code writer made non-text".into()))
-            .and_then(|t| verify_gcode(t, &Limits::from(&d.printer)).map_err(Failure::from))?;
+    // Right first time: the program is re-measured by the checker on its way to the disk (read
+    // as it is written, so the text is never kept whole); the file is put in place only if it
+    // passes, and a design that still breaks a limit on this printer is refused with what broke.
+    let mut verifier = d
+        .constraints
+        .enforce
+        .then(|| GcodeVerifier::with_capacity(job.toolpath.points.len() + 64));
+    let (pending, summary) = clayloft_core::atomic::prepare(out, |file| {
+        let mut sink = Tee {
+            file,
+            verifier: verifier.as_mut(),
+        };
+        write_gcode_summarized(d, &job, &mut sink)
+    })?;
+    if let Some(verifier) = verifier {
+        let report = verifier.finish(&Limits::from(&d.printer)).map_err(|e| {
+            Failure(format!(
+                "{}: the G-code written does not read back: {e}",
+                out.display()
+            ))
+        })?;
         if let Some(v) = report.as_ref().and_then(|r| r.violations.first()) {
+            // Dropped, the pending file is deleted: nothing is written.
+            drop(pending);
             return Err(Failure(format!(
                 "{}: does not print on this printer ({}): {} at {} points, worst {:.2} ({}); try a printer with a finer bead or thinner layers, or a simpler contour",
                 loaded.path.display(),
@@ -400,10 +415,30 @@ fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, F
             )));
         }
     }
-    clayloft_core::atomic::write_atomically(out, |w| w.write_all(&text))?;
+    pending.commit()?;
     print_summary(&loaded, &job, Some(summary));
     println!("wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes to the output file and, when there is one, to the self-check.
+struct Tee<'a> {
+    file: &'a mut dyn std::io::Write,
+    verifier: Option<&'a mut GcodeVerifier>,
+}
+
+impl std::io::Write for Tee<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.file.write_all(buf)?;
+        if let Some(v) = self.verifier.as_deref_mut() {
+            v.write_all(buf)?;
+        }
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
 }
 
 fn stl(design: &Path, out: &Path, ascii: bool, printer: Option<&str>) -> Result<ExitCode, Failure> {

@@ -68,6 +68,14 @@ fn every_profile_with_every_design_checks_or_says_it_does_not_fit() {
                     );
                     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
                     assert!(!out.exists(), "no file on error");
+                    // The program went to a temporary file on its way through the self-check:
+                    // refused, it is gone too.
+                    assert_eq!(
+                        std::fs::read_dir(dir.path()).unwrap().count(),
+                        0,
+                        "{} on {profile}: a temporary file was left",
+                        design.display()
+                    );
                 }
                 other => panic!("{} on {profile}: exit {other:?}: {err}", design.display()),
             }

@@ -23,6 +23,38 @@ pub fn write_atomically<T>(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<T>,
 ) -> Result<T, WriteError> {
+    let (pending, filled) = prepare(path, fill)?;
+    pending.commit()?;
+    Ok(filled)
+}
+
+/// A complete temporary file waiting to be renamed over its destination: [`Pending::commit`]
+/// puts it in place, dropping it deletes it. So that a file can be checked as it is written
+/// (`clayloft gcode` verifies its program on the way to the disk) and appear only if it passes.
+#[must_use = "dropped, the file is deleted: call commit() to put it in place"]
+pub struct Pending {
+    tmp: tempfile::NamedTempFile,
+    path: std::path::PathBuf,
+}
+
+impl Pending {
+    /// Renames the temporary file over the destination.
+    pub fn commit(self) -> Result<(), WriteError> {
+        let file = self.path.display().to_string();
+        self.tmp.persist(&self.path).map_err(|e| WriteError {
+            file,
+            reason: e.error.to_string(),
+        })?;
+        Ok(())
+    }
+}
+
+/// The first half of [`write_atomically`]: the temporary file beside `path`, filled by `fill`
+/// but not yet in place.
+pub fn prepare<T>(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<T>,
+) -> Result<(Pending, T), WriteError> {
     let err = |reason: String| WriteError {
         file: path.display().to_string(),
         reason,
@@ -59,8 +91,13 @@ pub fn write_atomically<T>(
         w.flush().map_err(|e| err(e.to_string()))?;
         filled
     };
-    tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
-    Ok(filled)
+    Ok((
+        Pending {
+            tmp,
+            path: path.to_path_buf(),
+        },
+        filled,
+    ))
 }
 
 #[cfg(test)]
@@ -109,6 +146,35 @@ mod tests {
         let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, 0o640);
         assert_eq!(std::fs::read(&out).unwrap(), b"G1 X2");
+    }
+
+    #[test]
+    fn a_pending_file_appears_only_when_committed() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("a.gcode");
+        std::fs::write(&out, b"old").unwrap();
+        let (pending, ()) = prepare(&out, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), b"old", "not yet in place");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+        drop(pending);
+        assert_eq!(
+            std::fs::read(&out).unwrap(),
+            b"old",
+            "dropped: the old file stays"
+        );
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary left"
+        );
+        let (pending, ()) = prepare(&out, |w| w.write_all(b"new")).unwrap();
+        pending.commit().unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), b"new");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary left"
+        );
     }
 
     #[test]

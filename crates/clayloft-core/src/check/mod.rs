@@ -24,7 +24,7 @@ mod report;
 use glam::DVec3;
 
 pub use limits::{Limits, LimitsError};
-pub use moves::{GcodeError, Move, parse_moves};
+pub use moves::{GcodeError, Move, MoveReader, parse_moves};
 use report::Tally;
 pub use report::{
     COLLISION, CheckReport, NOT_MEASURED, OVERHANG, PathEvent, UNSUPPORTED, Violation,
@@ -43,15 +43,69 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
 /// up on (its candidate budget spent, "not measurable") while a witness shows every point: that
 /// file passes here.
 pub fn verify_gcode(text: &str, limits: &Limits) -> Result<Option<CheckReport>, GcodeError> {
-    let (report, shown) = check_gcode_in(text, limits, true)?;
+    validate(limits)?;
+    let (moves, start) = parse_moves(text)?;
+    verify_moves(moves, start, limits)
+}
+
+/// [`verify_gcode`] of a program as it is written: the text goes in through
+/// [`std::io::Write`] in pieces of any size and is read into moves as it comes
+/// ([`MoveReader`]), so that it need not be kept whole; [`GcodeVerifier::finish`] gives the
+/// verdict. What `clayloft gcode` writes its file through.
+pub struct GcodeVerifier {
+    reader: MoveReader,
+}
+
+impl GcodeVerifier {
+    /// A verifier with room for about `moves` moves.
+    pub fn with_capacity(moves: usize) -> Self {
+        GcodeVerifier {
+            reader: MoveReader::with_capacity(moves),
+        }
+    }
+
+    /// [`verify_gcode`]'s verdict on the text written.
+    pub fn finish(self, limits: &Limits) -> Result<Option<CheckReport>, GcodeError> {
+        validate(limits)?;
+        let (moves, start) = self.reader.finish()?;
+        verify_moves(moves, start, limits)
+    }
+}
+
+impl std::io::Write for GcodeVerifier {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.reader.feed(buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// [`verify_gcode`] of moves read already.
+fn verify_moves(
+    moves: Vec<Move>,
+    start: DVec3,
+    limits: &Limits,
+) -> Result<Option<CheckReport>, GcodeError> {
+    let (report, shown) = check_moves(&moves, start, limits, true)?;
     match (shown, report.violations.is_empty()) {
         (true, true) => Ok(None),
         // Not shown: the layers were measured in full after all, and this is the report.
         (false, _) => Ok(Some(report)),
         // The layers shown, another limit broken (the bed, the holder): measured again for the
         // layers' figures of the report.
-        (true, false) => check_gcode(text, limits).map(Some),
+        (true, false) => check_moves(&moves, start, limits, false).map(|(r, _)| Some(r)),
     }
+}
+
+/// The limits, or why they cannot be checked against (as an error of the program's first line).
+fn validate(limits: &Limits) -> Result<(), GcodeError> {
+    limits.validate().map_err(|e| GcodeError {
+        line: e.line.unwrap_or(1),
+        message: format!("limits: {e}"),
+    })
 }
 
 /// [`check_gcode`]; with `show`, the layers are first shown to hold by witnesses (see
@@ -62,18 +116,23 @@ fn check_gcode_in(
     limits: &Limits,
     show: bool,
 ) -> Result<(CheckReport, bool), GcodeError> {
-    limits.validate().map_err(|e| GcodeError {
-        line: e.line.unwrap_or(1),
-        message: format!("limits: {e}"),
-    })?;
-    let (mut moves, mut start) = parse_moves(text)?;
+    validate(limits)?;
+    let (moves, start) = parse_moves(text)?;
+    check_moves(&moves, start, limits, show)
+}
+
+/// [`check_gcode_in`] of moves read already (`start`: where the first begins), in the file's
+/// coordinates.
+fn check_moves(
+    moves: &[Move],
+    start: DVec3,
+    limits: &Limits,
+    show: bool,
+) -> Result<(CheckReport, bool), GcodeError> {
     // Into the bed frame: the file's coordinates are the printer's own.
     let [ox, oy] = limits.origin_offset();
     let shift = DVec3::new(ox, oy, 0.0);
-    for m in &mut moves {
-        m.to += shift;
-    }
-    start += shift;
+    let start = start + shift;
     if moves.is_empty() {
         return Err(GcodeError {
             line: 1,
@@ -92,12 +151,13 @@ fn check_gcode_in(
     let last_ext = moves.iter().rposition(|m| m.de > 0.0);
     let mut prev = start;
     for (k, m) in moves.iter().enumerate() {
+        let to = m.to + shift;
         if m.de > 0.0 {
-            lo = lo.min(m.to);
-            hi = hi.max(m.to);
+            lo = lo.min(to);
+            hi = hi.max(to);
         }
         let eps = 1e-6;
-        if !limits.on_bed(m.to.x, m.to.y, eps) || m.to.z < -eps || m.to.z > limits.max_z + eps {
+        if !limits.on_bed(to.x, to.y, eps) || to.z < -eps || to.z > limits.max_z + eps {
             outside.add(0.0, m.line);
         }
         if m.de < 0.0 {
@@ -107,11 +167,11 @@ fn check_gcode_in(
             && k > a
             && k <= b
             && m.de <= 0.0
-            && m.to != prev
+            && to != prev
         {
-            travel.add(m.to.distance(prev), m.line);
+            travel.add(to.distance(prev), m.line);
         }
-        prev = m.to;
+        prev = to;
     }
     if lo.is_finite() {
         report.bounds_min = lo;
@@ -144,10 +204,14 @@ fn check_gcode_in(
     if let (Some(a), Some(b)) = (first_ext, last_ext) {
         let mut vertices = Vec::with_capacity(b - a + 2);
         let mut lines = Vec::with_capacity(b - a + 2);
-        vertices.push(if a == 0 { start } else { moves[a - 1].to });
+        vertices.push(if a == 0 {
+            start
+        } else {
+            moves[a - 1].to + shift
+        });
         lines.push(moves[a].line);
         for m in &moves[a..=b] {
-            vertices.push(m.to);
+            vertices.push(m.to + shift);
             lines.push(m.line);
         }
         report.extruding_moves = moves[a..=b].iter().filter(|m| m.de > 0.0).count();
@@ -269,6 +333,33 @@ mod tests {
             helix(1.5, 10, 1.0),
         ] {
             let checked = check_gcode(&text, &limits()).unwrap();
+            // Written to the verifier in pieces cut anywhere: the same verdict.
+            for piece in [1, 7, 4096] {
+                let mut verifier = GcodeVerifier::with_capacity(0);
+                for bytes in text.as_bytes().chunks(piece) {
+                    std::io::Write::write_all(&mut verifier, bytes).unwrap();
+                }
+                assert_eq!(
+                    verifier.finish(&limits()),
+                    verify_gcode(&text, &limits()),
+                    "pieces of {piece}"
+                );
+            }
+            // A bed too small for it: the layers shown, the bed broken, the full report.
+            let small = Limits {
+                bed_x: 100.0,
+                ..limits()
+            };
+            let mut verifier = GcodeVerifier::with_capacity(0);
+            std::io::Write::write_all(&mut verifier, text.as_bytes()).unwrap();
+            let report = verifier.finish(&small).unwrap().expect("off the bed");
+            assert_eq!(report, check_gcode(&text, &small).unwrap());
+            assert!(
+                report
+                    .violations
+                    .iter()
+                    .any(|v| v.what == "outside the machine")
+            );
             match verify_gcode(&text, &limits()).unwrap() {
                 None => assert!(checked.ok(), "{checked}"),
                 Some(report) => {

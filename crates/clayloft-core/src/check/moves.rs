@@ -70,6 +70,94 @@ fn parse_moves_in(text: &str, part_bytes: usize) -> Result<(Vec<Move>, DVec3), G
     Ok((moves, state.start.unwrap_or(DVec3::ZERO)))
 }
 
+/// The moves of a G-code program read as its text arrives, in pieces cut anywhere (a program
+/// checked while it is written need not be kept whole): each piece's complete lines are read
+/// and resolved at once, a cut line waits for its end. The moves and the first error are those
+/// of [`parse_moves`] on the whole text (tested).
+pub struct MoveReader {
+    state: State,
+    /// Lines read so far.
+    lines: usize,
+    /// The start of a line cut by the last piece.
+    partial: Vec<u8>,
+    moves: Vec<Move>,
+    /// The first error; nothing more is read after it.
+    error: Option<GcodeError>,
+}
+
+impl MoveReader {
+    /// A reader with room for `moves` moves.
+    pub fn with_capacity(moves: usize) -> Self {
+        MoveReader {
+            state: State::default(),
+            lines: 0,
+            partial: Vec::new(),
+            moves: Vec::with_capacity(moves),
+            error: None,
+        }
+    }
+
+    /// Reads the complete lines of `bytes` (with the cut line before them).
+    pub fn feed(&mut self, bytes: &[u8]) {
+        if self.error.is_some() {
+            return;
+        }
+        let Some(last) = bytes.iter().rposition(|&b| b == b'\n') else {
+            self.partial.extend_from_slice(bytes);
+            return;
+        };
+        let (lines, rest) = bytes.split_at(last + 1);
+        if self.partial.is_empty() {
+            self.read(lines);
+        } else {
+            let mut joined = std::mem::take(&mut self.partial);
+            joined.extend_from_slice(lines);
+            self.read(&joined);
+        }
+        self.partial.extend_from_slice(rest);
+    }
+
+    /// The moves and where the first starts, once the whole text is in.
+    pub fn finish(mut self) -> Result<(Vec<Move>, DVec3), GcodeError> {
+        let rest = std::mem::take(&mut self.partial);
+        if !rest.is_empty() && self.error.is_none() {
+            self.read(&rest);
+        }
+        match self.error {
+            Some(e) => Err(e),
+            None => Ok((self.moves, self.state.start.unwrap_or(DVec3::ZERO))),
+        }
+    }
+
+    /// Reads whole lines (a line cut only at the end of the text).
+    fn read(&mut self, lines: &[u8]) {
+        // A newline is never part of a multi-byte character: each piece of whole lines is text
+        // or not on its own.
+        let text = match std::str::from_utf8(lines) {
+            Ok(t) => t,
+            Err(e) => {
+                let line = self.lines
+                    + 1
+                    + lines[..e.valid_up_to()]
+                        .iter()
+                        .filter(|&&b| b == b'\n')
+                        .count();
+                self.error = Some(GcodeError {
+                    line,
+                    message: "not text (UTF-8)".into(),
+                });
+                return;
+            }
+        };
+        let part = read_part(text);
+        let count = part.lines;
+        if let Err(e) = part.resolve(&mut self.state, self.lines, &mut self.moves) {
+            self.error = Some(e);
+        }
+        self.lines += count;
+    }
+}
+
 /// What changes the modal state, read from one line.
 #[derive(Debug, Clone, Copy)]
 enum Modal {
@@ -548,8 +636,28 @@ mod tests {
             let text = lines.join(if crlf { "\r\n" } else { "\n" });
             let reference = parse_moves_reference(&text);
             prop_assert_eq!(parse_moves_in(&text, usize::MAX), reference.clone());
-            prop_assert_eq!(parse_moves_in(&text, part_bytes), reference);
+            prop_assert_eq!(parse_moves_in(&text, part_bytes), reference.clone());
+            // Fed to the reader in pieces cut anywhere (in a line, in a CRLF, in a number).
+            let mut reader = MoveReader::with_capacity(0);
+            for piece in text.as_bytes().chunks(part_bytes) {
+                reader.feed(piece);
+            }
+            prop_assert_eq!(reader.finish(), reference);
         }
+    }
+
+    #[test]
+    fn a_reader_names_the_line_that_is_not_text() {
+        let mut reader = MoveReader::with_capacity(0);
+        reader.feed(b"G1 X1\nG1 X");
+        reader.feed(b"2\n; caf\xc3");
+        reader.feed(b"\xa9 ok\nG1 X\xff\nG1 X3\n");
+        let e = reader.finish().unwrap_err();
+        assert_eq!((e.line, e.message.as_str()), (4, "not text (UTF-8)"));
+        let mut reader = MoveReader::with_capacity(0);
+        reader.feed(b"G1 X1\nG1 X2 E1");
+        let (moves, _) = reader.finish().unwrap();
+        assert_eq!((moves.len(), moves[1].to.x, moves[1].de), (2, 2.0, 1.0));
     }
 
     #[test]
