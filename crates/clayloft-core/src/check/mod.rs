@@ -14,7 +14,8 @@
 //!   nozzle tip (the holder is treated as a plane `nozzle_length` above the tip).
 //!
 //! [`check_gcode`] measures every point (the report's figures); [`verify_gcode`] only asks
-//! whether the limits hold, and shows most points' layers by a witness instead.
+//! whether the limits hold, and shows most points' layers by a witness instead;
+//! [`GcodeVerifier`] is `verify_gcode` of a program read as it is written.
 
 mod layers;
 mod limits;
@@ -32,7 +33,9 @@ pub use report::{
 
 /// Re-measures a G-code program against `limits`. Errors only when the text is not G-code.
 pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeError> {
-    check_gcode_in(text, limits, false).map(|(report, _)| report)
+    validate(limits)?;
+    let (moves, start) = parse_moves(text)?;
+    check_moves(&moves, start, limits, false).map(|(report, _)| report)
 }
 
 /// Whether a G-code program keeps `limits`: `Ok(None)` when it does, shown without measuring
@@ -45,7 +48,7 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
 pub fn verify_gcode(text: &str, limits: &Limits) -> Result<Option<CheckReport>, GcodeError> {
     validate(limits)?;
     let (moves, start) = parse_moves(text)?;
-    verify_moves(moves, start, limits)
+    verify_moves(&moves, start, limits)
 }
 
 /// [`verify_gcode`] of a program as it is written: the text goes in through
@@ -68,7 +71,7 @@ impl GcodeVerifier {
     pub fn finish(self, limits: &Limits) -> Result<Option<CheckReport>, GcodeError> {
         validate(limits)?;
         let (moves, start) = self.reader.finish()?;
-        verify_moves(moves, start, limits)
+        verify_moves(&moves, start, limits)
     }
 }
 
@@ -85,18 +88,18 @@ impl std::io::Write for GcodeVerifier {
 
 /// [`verify_gcode`] of moves read already.
 fn verify_moves(
-    moves: Vec<Move>,
+    moves: &[Move],
     start: DVec3,
     limits: &Limits,
 ) -> Result<Option<CheckReport>, GcodeError> {
-    let (report, shown) = check_moves(&moves, start, limits, true)?;
+    let (report, shown) = check_moves(moves, start, limits, true)?;
     match (shown, report.violations.is_empty()) {
         (true, true) => Ok(None),
         // Not shown: the layers were measured in full after all, and this is the report.
         (false, _) => Ok(Some(report)),
         // The layers shown, another limit broken (the bed, the holder): measured again for the
         // layers' figures of the report.
-        (true, false) => check_moves(&moves, start, limits, false).map(|(r, _)| Some(r)),
+        (true, false) => check_moves(moves, start, limits, false).map(|(r, _)| Some(r)),
     }
 }
 
@@ -108,21 +111,10 @@ fn validate(limits: &Limits) -> Result<(), GcodeError> {
     })
 }
 
-/// [`check_gcode`]; with `show`, the layers are first shown to hold by witnesses (see
+/// [`check_gcode`] of moves read already (`start`: where the first begins), in the file's
+/// coordinates; with `show`, the layers are first shown to hold by witnesses (see
 /// [`verify_gcode`]), and the second value says whether they were (the report then lacks the
 /// layers' figures).
-fn check_gcode_in(
-    text: &str,
-    limits: &Limits,
-    show: bool,
-) -> Result<(CheckReport, bool), GcodeError> {
-    validate(limits)?;
-    let (moves, start) = parse_moves(text)?;
-    check_moves(&moves, start, limits, show)
-}
-
-/// [`check_gcode_in`] of moves read already (`start`: where the first begins), in the file's
-/// coordinates.
 fn check_moves(
     moves: &[Move],
     start: DVec3,

@@ -106,13 +106,20 @@ impl MoveReader {
             self.partial.extend_from_slice(bytes);
             return;
         };
-        let (lines, rest) = bytes.split_at(last + 1);
-        if self.partial.is_empty() {
-            self.read(lines);
-        } else {
+        let (mut lines, rest) = bytes.split_at(last + 1);
+        if !self.partial.is_empty() {
+            // The cut line, completed, on its own: the rest of the piece is read where it is.
+            let end = lines
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(lines.len(), |k| k + 1);
             let mut joined = std::mem::take(&mut self.partial);
-            joined.extend_from_slice(lines);
+            joined.extend_from_slice(&lines[..end]);
             self.read(&joined);
+            lines = &lines[end..];
+        }
+        if !lines.is_empty() && self.error.is_none() {
+            self.read(lines);
         }
         self.partial.extend_from_slice(rest);
     }
