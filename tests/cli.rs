@@ -961,3 +961,35 @@ fn bad_meshes_exit_2_naming_the_file_and_the_problem() {
         assert!(!gcode.exists(), "{name}: no output file");
     }
 }
+
+/// G-code sent to a pipe (as to `/dev/stdout` or a device) goes into it once checked; the pipe
+/// is never renamed over (as root, `-o /dev/full` once replaced the device with a file).
+#[cfg(target_os = "linux")]
+#[test]
+fn gcode_goes_into_a_pipe_and_leaves_it_a_pipe() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("printer");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+    };
+    let run = clayloft(&[
+        "gcode",
+        "assets/designs/petal-vase.toml",
+        "-o",
+        fifo.to_str().unwrap(),
+    ]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let g = reader.join().unwrap();
+    assert!(g.lines().filter(|l| l.starts_with("G1 X")).count() > 40_000);
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}

@@ -5,9 +5,14 @@
 //! Permissions are those any program's new files get: read/write for all less the user's umask
 //! (0644 under the usual 022), so that a printer host running as another user can read the
 //! G-code. A file that is replaced keeps the permissions it had.
+//!
+//! A symbolic link is followed: the file it points to is replaced and the link stays. A
+//! destination that exists and is not a file (a terminal, a pipe, `/dev/stdout`, a device) is
+//! never renamed over: the data waits in a temporary file of the system's temporary folder and
+//! is written into the destination when complete.
 
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Why an output file could not be written, as one sentence.
 #[derive(Debug, thiserror::Error)]
@@ -28,29 +33,63 @@ pub fn write_atomically<T>(
     Ok(filled)
 }
 
-/// A complete temporary file waiting to be renamed over its destination: [`Pending::commit`]
-/// puts it in place, dropping it deletes it. So that a file can be checked as it is written
-/// (`clayloft gcode` verifies its program on the way to the disk) and appear only if it passes.
+/// A complete temporary file waiting to go to its destination: [`Pending::commit`] puts it in
+/// place, dropping it deletes it. So that a file can be checked as it is written (`clayloft
+/// gcode` verifies its program on the way to the disk) and appear only if it passes.
 #[must_use = "dropped, the file is deleted: call commit() to put it in place"]
 pub struct Pending {
     tmp: tempfile::NamedTempFile,
-    path: std::path::PathBuf,
+    /// The file the destination's path names (a link followed) and whether it is renamed over.
+    target: PathBuf,
+    rename: bool,
+    /// The path as given, for messages.
+    path: PathBuf,
 }
 
 impl Pending {
-    /// Renames the temporary file over the destination.
+    /// Renames the temporary file over the destination, or, for a destination that is not a
+    /// file, writes the data into it.
     pub fn commit(self) -> Result<(), WriteError> {
-        let file = self.path.display().to_string();
-        self.tmp.persist(&self.path).map_err(|e| WriteError {
-            file,
-            reason: e.error.to_string(),
-        })?;
-        Ok(())
+        let err = |reason: String| WriteError {
+            file: self.path.display().to_string(),
+            reason,
+        };
+        if self.rename {
+            return self
+                .tmp
+                .persist(&self.target)
+                .map(|_| ())
+                .map_err(|e| err(e.error.to_string()));
+        }
+        let mut data = self.tmp.reopen().map_err(|e| err(e.to_string()))?;
+        let mut out = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&self.target)
+            .map_err(|e| err(e.to_string()))?;
+        std::io::copy(&mut data, &mut out)
+            .and_then(|_| out.flush())
+            .map_err(|e| err(e.to_string()))
     }
 }
 
-/// The first half of [`write_atomically`]: the temporary file beside `path`, filled by `fill`
-/// but not yet in place.
+/// Where the data for `path` goes: the file to rename the finished data over (a symbolic link
+/// followed to the file it names, so the link stays), or, for anything that exists and is not
+/// a file (a terminal, a pipe, a device, `/dev/stdout`, which names the process's own output
+/// through a link of the system's), `path` itself, written into and never renamed over.
+fn destination(path: &Path) -> (PathBuf, bool) {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => (std::fs::canonicalize(path).unwrap_or(path.into()), true),
+        Ok(_) => (path.into(), false),
+        // Nothing there yet; a link to a file not made yet makes that file.
+        Err(_) => match std::fs::read_link(path) {
+            Ok(to) => (path.parent().unwrap_or(Path::new("")).join(to), true),
+            Err(_) => (path.into(), true),
+        },
+    }
+}
+
+/// The first half of [`write_atomically`]: the temporary file, filled by `fill` but not yet
+/// in place.
 pub fn prepare<T>(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<T>,
@@ -59,17 +98,18 @@ pub fn prepare<T>(
         file: path.display().to_string(),
         reason,
     };
-    let dir = match path.parent() {
+    let (target, rename) = destination(path);
+    let dir = match target.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
     if !dir.is_dir() {
         return Err(err(format!("the folder {} does not exist", dir.display())));
     }
-    if path.is_dir() {
+    let existing = std::fs::metadata(&target).ok();
+    if existing.as_ref().is_some_and(|m| m.is_dir()) {
         return Err(err("it is a folder".into()));
     }
-    let existing = std::fs::metadata(path).ok().map(|m| m.permissions());
     let mut builder = tempfile::Builder::new();
     builder.prefix(".clayloft-").suffix(".part");
     #[cfg(unix)]
@@ -79,10 +119,15 @@ pub fn prepare<T>(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let tmp = builder.tempfile_in(dir).map_err(|e| err(e.to_string()))?;
-    if let Some(p) = existing {
+    let tmp = if rename {
+        builder.tempfile_in(dir)
+    } else {
+        builder.tempfile()
+    }
+    .map_err(|e| err(e.to_string()))?;
+    if let Some(m) = existing.filter(|_| rename) {
         tmp.as_file()
-            .set_permissions(p)
+            .set_permissions(m.permissions())
             .map_err(|e| err(e.to_string()))?;
     }
     let filled = {
@@ -94,6 +139,8 @@ pub fn prepare<T>(
     Ok((
         Pending {
             tmp,
+            target,
+            rename,
             path: path.to_path_buf(),
         },
         filled,
@@ -175,6 +222,76 @@ mod tests {
             1,
             "no temporary left"
         );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_is_followed_and_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.gcode");
+        std::fs::write(&real, b"old").unwrap();
+        let link = dir.path().join("current.gcode");
+        std::os::unix::fs::symlink("real.gcode", &link).unwrap();
+        write_atomically(&link, |w| w.write_all(b"new")).unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        // A link to a file not made yet makes it.
+        let dangling = dir.path().join("next.gcode");
+        std::os::unix::fs::symlink("made.gcode", &dangling).unwrap();
+        write_atomically(&dangling, |w| w.write_all(b"made")).unwrap();
+        assert_eq!(
+            std::fs::read(dir.path().join("made.gcode")).unwrap(),
+            b"made"
+        );
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            4,
+            "no temporary left"
+        );
+    }
+
+    /// A pipe gets the data and stays a pipe, never renamed over; likewise through a link (the
+    /// shape of `/dev/stdout`, a link to the process's output). Before, as root, `-o /dev/full`
+    /// replaced the device with a file.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_pipe_is_written_into_not_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let link = dir.path().join("out");
+        std::os::unix::fs::symlink(&fifo, &link).unwrap();
+        for (path, data) in [(&fifo, b"G1 X1\n"), (&link, b"G1 X2\n")] {
+            let reader = {
+                let fifo = fifo.clone();
+                std::thread::spawn(move || std::fs::read(fifo).unwrap())
+            };
+            let (pending, ()) = prepare(path, |w| w.write_all(data)).unwrap();
+            assert_eq!(
+                std::fs::read_dir(dir.path()).unwrap().count(),
+                2,
+                "the temporary is elsewhere"
+            );
+            pending.commit().unwrap();
+            assert_eq!(reader.join().unwrap(), data);
+            assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+            assert!(
+                std::fs::symlink_metadata(&link)
+                    .unwrap()
+                    .file_type()
+                    .is_symlink()
+            );
+        }
     }
 
     #[test]
