@@ -1,0 +1,40 @@
+#!/usr/bin/env python3
+"""Times `clayloft gcode` of the benchmark vessel as a whole process, for one or more binaries
+run in turn (so that the machine's drifting speed falls on all alike), back to back or after a
+pause (a single command after the machine idled, as a potter runs it).
+
+    scripts/whole-process.py OLD_BINARY NEW_BINARY            # 30 rounds back to back
+    scripts/whole-process.py --pause 1.5 --rounds 12 OLD NEW  # each run after 1.5 s idle
+
+Prints the minimum, first quartile, median and maximum wall time of each, in ms.
+"""
+import argparse
+import statistics
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+DESIGN = Path(__file__).resolve().parent.parent / "assets/benchmarks/vase-720x300.toml"
+
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("binaries", nargs="+")
+parser.add_argument("--rounds", type=int, default=30)
+parser.add_argument("--pause", type=float, default=0.0, help="seconds idle before each run")
+parser.add_argument("--design", default=str(DESIGN))
+args = parser.parse_args()
+
+with tempfile.TemporaryDirectory() as work:
+    out = str(Path(work) / "vase.gcode")
+    times = {b: [] for b in args.binaries}
+    for _ in range(args.rounds):
+        for b in args.binaries:
+            time.sleep(args.pause)
+            start = time.perf_counter()
+            subprocess.run([b, "gcode", args.design, "-o", out], check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            times[b].append((time.perf_counter() - start) * 1000)
+    for b, t in times.items():
+        t.sort()
+        print(f"{b}: min {t[0]:.1f}  p25 {t[len(t) // 4]:.1f}  "
+              f"median {statistics.median(t):.1f}  max {t[-1]:.1f} ms")
