@@ -130,14 +130,23 @@ pub(crate) const EXACT_POWERS: [f64; 23] = [
 ];
 
 /// `text` as a number, exactly as `text.parse::<f64>()` reads it, reading the plain decimals a
-/// G-code file is made of (`-12.345`, `7`, `.5`) itself and leaving anything else to the
-/// standard library.
+/// G-code file is made of (`-12.345`, `7`, `.5`) itself ([`plain_decimal`]) and leaving anything
+/// else to the standard library.
+pub fn parse_f64(text: &str) -> Result<f64, std::num::ParseFloatError> {
+    match plain_decimal(text.as_bytes()) {
+        Some(v) => Ok(v),
+        None => text.parse(),
+    }
+}
+
+/// A plain decimal (an optional sign, digits with at most one point) read exactly as
+/// `str::parse::<f64>` reads it; None for anything else, and for a decimal this fast path does
+/// not take (more than 19 digits, or a mantissa from 2⁵³ on).
 ///
 /// A plain decimal of m's digits with k after the point is m / 10^k. When m < 2⁵³ and k ≤ 22
 /// both are exact doubles, and one division rounds the quotient correctly (IEEE 754), as the
 /// standard parser does (Clinger's fast path): the same bits.
-pub fn parse_f64(text: &str) -> Result<f64, std::num::ParseFloatError> {
-    let bytes = text.as_bytes();
+pub fn plain_decimal(bytes: &[u8]) -> Option<f64> {
     let (negative, digits) = match bytes.first() {
         Some(b'-') => (true, &bytes[1..]),
         Some(b'+') => (false, &bytes[1..]),
@@ -152,14 +161,14 @@ pub fn parse_f64(text: &str) -> Result<f64, std::num::ParseFloatError> {
                 after_point += usize::from(point);
             }
             b'.' if !point => point = true,
-            _ => return text.parse(),
+            _ => return None,
         }
     }
     if count == 0 || m >= 1 << 53 || after_point >= EXACT_POWERS.len() {
-        return text.parse();
+        return None;
     }
     let v = m as f64 / EXACT_POWERS[after_point];
-    Ok(if negative { -v } else { v })
+    Some(if negative { -v } else { v })
 }
 
 /// Appends `v` with exactly `decimals` digits after the point to `buf` (see [`Line::fixed`]).

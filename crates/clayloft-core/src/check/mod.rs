@@ -25,7 +25,8 @@ mod report;
 use glam::DVec3;
 
 pub use limits::{Limits, LimitsError};
-pub use moves::{GcodeError, Move, MoveReader, parse_moves};
+use moves::MoveReader;
+pub use moves::{GcodeError, Move, parse_moves};
 use report::Tally;
 pub use report::{
     COLLISION, CheckReport, NOT_MEASURED, OVERHANG, PathEvent, UNSUPPORTED, Violation,

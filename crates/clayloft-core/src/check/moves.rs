@@ -334,22 +334,19 @@ fn words_of(raw: &str) -> Option<(&str, [Option<&str>; 4])> {
 }
 
 /// A move in the form the G-code writer gives every path point (`G1 X… Y… Z… E… F…`: upper
-/// case, one space before each word, plain decimals of at most 15 digits, each letter at most
-/// once, nothing else on the line), read in one pass over its bytes: the X, Y, Z and E given
-/// (NaN where not given), each the value [`crate::decimal::parse_f64`] gives (m / 10^k, one
-/// division). None for any other line, which [`words_of`] reads (tested: both read alike).
+/// case, one space before each word, plain decimals, each letter at most once, nothing else on
+/// the line), read in one pass over its bytes: the X, Y, Z and E given (NaN where not given),
+/// each read by [`crate::decimal::plain_decimal`], as [`words_of`]'s numbers are. None for any
+/// other line, which [`words_of`] reads (tested: both read alike).
 fn plain_move(raw: &[u8]) -> Option<[f64; 4]> {
     let rest = raw
-        .strip_prefix(b"G1")
-        .or_else(|| raw.strip_prefix(b"G0"))?;
+        .strip_prefix(b"G1 ")
+        .or_else(|| raw.strip_prefix(b"G0 "))?;
     let mut given = [f64::NAN; 5];
     let mut seen = [false; 5];
-    let mut i = 0;
-    while i < rest.len() {
-        if rest[i] != b' ' {
-            return None;
-        }
-        let slot = match rest.get(i + 1)? {
+    for word in rest.split(|&b| b == b' ') {
+        let (&letter, number) = word.split_first()?;
+        let slot = match letter {
             b'X' => 0,
             b'Y' => 1,
             b'Z' => 2,
@@ -360,34 +357,9 @@ fn plain_move(raw: &[u8]) -> Option<[f64; 4]> {
         if std::mem::replace(&mut seen[slot], true) {
             return None;
         }
-        i += 2;
-        let negative = rest.get(i) == Some(&b'-');
-        i += usize::from(negative);
-        let (mut m, mut digits, mut after_point, mut point) = (0u64, 0usize, 0usize, false);
-        while let Some(&b) = rest.get(i) {
-            match b {
-                b'0'..=b'9' => {
-                    m = m * 10 + u64::from(b - b'0');
-                    digits += 1;
-                    after_point += usize::from(point);
-                }
-                b'.' if !point => point = true,
-                b' ' => break,
-                _ => return None,
-            }
-            i += 1;
-            if digits > 15 {
-                return None;
-            }
-        }
-        if digits == 0 {
-            return None;
-        }
-        // Below 10^15 < 2^53, after at most 15 digits: exact, one rounding (see parse_f64).
-        let v = m as f64 / crate::decimal::EXACT_POWERS[after_point];
-        given[slot] = if negative { -v } else { v };
+        given[slot] = crate::decimal::plain_decimal(number)?;
     }
-    (!rest.is_empty()).then_some([given[0], given[1], given[2], given[3]])
+    Some([given[0], given[1], given[2], given[3]])
 }
 
 fn read_lines(text: &str, part: &mut Part) -> Result<(), GcodeError> {
