@@ -136,6 +136,7 @@ pub fn prepare<T>(
         w.flush().map_err(|e| err(e.to_string()))?;
         filled
     };
+    start_writeback(tmp.as_file());
     Ok((
         Pending {
             tmp,
@@ -146,6 +147,23 @@ pub fn prepare<T>(
         filled,
     ))
 }
+
+/// Starts the file's data for the disk without waiting for it. A rename that replaces a file
+/// on ext4 writes the new file's data out first (`auto_da_alloc`, which keeps a crash from
+/// leaving it empty): 4–5 ms for the benchmark vase's 8 MB inside `Pending::commit`; started
+/// here, the rename takes about 2 ms (the old file's pages freed) and the start 0.3 ms. A hint
+/// only: if it fails, the rename does the writing as before.
+#[cfg(target_os = "linux")]
+fn start_writeback(file: &std::fs::File) {
+    use std::os::fd::AsRawFd;
+    // SAFETY: the descriptor is open (borrowed from `file`) and the call only queues writes.
+    unsafe {
+        libc::sync_file_range(file.as_raw_fd(), 0, 0, libc::SYNC_FILE_RANGE_WRITE);
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn start_writeback(_: &std::fs::File) {}
 
 #[cfg(test)]
 mod tests {

@@ -413,6 +413,15 @@ pub(super) fn chords(v: &[DVec3]) -> Vec<(usize, usize)> {
     out
 }
 
+/// The length of path `v` up to each of its points, mm.
+fn running_length(v: &[DVec3]) -> Vec<f64> {
+    let mut cum = vec![0.0; v.len()];
+    for j in 1..v.len() {
+        cum[j] = cum[j - 1] + v[j - 1].distance(v[j]);
+    }
+    cum
+}
+
 /// Measures the layers of an extruding path `v` (see the module documentation of
 /// [`crate::check`]); `lines` gives each point's G-code line (or index) for the report. Points
 /// outside the machine (already a violation of their own) are neither searched nor searched for.
@@ -492,7 +501,9 @@ fn measure_layers_in(
     } else {
         radius
     };
-    let chords = chords(v);
+    // The path's length up to each point on a second core while this one finds the chords.
+    let (cum, chords) =
+        crate::parallel::both(v.len() >= 20_000, || running_length(v), || chords(v));
     let index = match search {
         // The tree holds what the grid holds, and is never too large to build.
         Search::Tree => Some(ChordIndex::Tree(ChordTree::build(
@@ -525,10 +536,6 @@ fn measure_layers_in(
             columns: Vec::new(),
         })
     });
-    let mut cum = vec![0.0; v.len()];
-    for j in 1..v.len() {
-        cum[j] = cum[j - 1] + v[j - 1].distance(v[j]);
-    }
     report.path_length_mm = cum[v.len() - 1];
     let search = LayerSearch {
         v,
@@ -552,9 +559,8 @@ fn measure_layers_in(
     let layer_limits = LayerLimits::of(limits);
     let budget = CANDIDATES_BASE.saturating_add(CANDIDATES_PER_POINT.saturating_mul(v.len()));
     let shown = first_show && measurable && search.proves_all(budget, layer_limits);
-    let below: Vec<Below> = if shown {
-        vec![Below::Skipped; v.len()]
-    } else if measurable {
+    // Shown or not measurable: no point's layers to tally (the holder's clearance only).
+    let below: Vec<Below> = if measurable && !shown {
         search.all(budget)
     } else {
         Vec::new()
@@ -582,10 +588,10 @@ fn measure_layers_in(
             });
         }
         running_max_z = running_max_z.max(p.z);
-        if !measurable {
+        let Some(&below) = below.get(j).filter(|_| measurable) else {
             continue;
-        }
-        let (height, angle) = match below[j] {
+        };
+        let (height, angle) = match below {
             Below::Skipped => continue,
             Below::Unmeasurable => {
                 measurable = false;
@@ -1176,8 +1182,12 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         found
     }
 
-    /// Whether the grid holds chord `id`: both ends inside the machine, and not steep.
+    /// Whether the search holds chord `id`: both ends inside the machine, and not steep (as
+    /// the tree, when searched, has it already).
     fn held(&self, id: usize) -> bool {
+        if let ChordIndex::Tree(tree) = self.index {
+            return tree.holds(id);
+        }
         let (a, b) = (self.v[self.chords[id].0], self.v[self.chords[id].1]);
         (self.inside)(a) && (self.inside)(b) && !steep(a, b)
     }

@@ -136,12 +136,55 @@ fn check_moves(
         moves: moves.len(),
         ..Default::default()
     };
+    let first_ext = moves.iter().position(|m| m.de > 0.0);
+    let last_ext = moves.iter().rposition(|m| m.de > 0.0);
+    // The extruding path, copied out for the layer search on a second core while this one
+    // tallies the moves.
+    let copy_path = || {
+        let (a, b) = (first_ext?, last_ext?);
+        let mut vertices = Vec::with_capacity(b - a + 2);
+        let mut lines = Vec::with_capacity(b - a + 2);
+        vertices.push(if a == 0 {
+            start
+        } else {
+            moves[a - 1].to + shift
+        });
+        lines.push(moves[a].line);
+        for m in &moves[a..=b] {
+            vertices.push(m.to + shift);
+            lines.push(m.line);
+        }
+        Some((a..=b, vertices, lines))
+    };
+    let (path, ()) = crate::parallel::both(moves.len() >= 20_000, copy_path, || {
+        tally_moves(moves, start, limits, first_ext.zip(last_ext), &mut report)
+    });
+    if let Some((extruding, vertices, lines)) = path {
+        report.extruding_moves = moves[extruding].iter().filter(|m| m.de > 0.0).count();
+        if show {
+            let shown = layers::layers_hold(&vertices, &lines, limits, &mut report);
+            return Ok((report, shown));
+        }
+        layers::measure_layers(&vertices, &lines, limits, &mut report);
+    }
+    Ok((report, show))
+}
+
+/// The bounds of the extruding moves, and the violations of single moves (outside the machine,
+/// a move without extrusion within the path `extruding`, a retraction), into `report`.
+fn tally_moves(
+    moves: &[Move],
+    start: DVec3,
+    limits: &Limits,
+    extruding: Option<(usize, usize)>,
+    report: &mut CheckReport,
+) {
+    let [ox, oy] = limits.origin_offset();
+    let shift = DVec3::new(ox, oy, 0.0);
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     let (mut outside, mut travel, mut retract) =
         (Tally::default(), Tally::default(), Tally::default());
-    let first_ext = moves.iter().position(|m| m.de > 0.0);
-    let last_ext = moves.iter().rposition(|m| m.de > 0.0);
     let mut prev = start;
     for (k, m) in moves.iter().enumerate() {
         let to = m.to + shift;
@@ -156,7 +199,7 @@ fn check_moves(
         if m.de < 0.0 {
             retract.add(-m.de, m.line);
         }
-        if let (Some(a), Some(b)) = (first_ext, last_ext)
+        if let Some((a, b)) = extruding
             && k > a
             && k <= b
             && m.de <= 0.0
@@ -194,27 +237,6 @@ fn check_moves(
         .into_iter()
         .flatten(),
     );
-    if let (Some(a), Some(b)) = (first_ext, last_ext) {
-        let mut vertices = Vec::with_capacity(b - a + 2);
-        let mut lines = Vec::with_capacity(b - a + 2);
-        vertices.push(if a == 0 {
-            start
-        } else {
-            moves[a - 1].to + shift
-        });
-        lines.push(moves[a].line);
-        for m in &moves[a..=b] {
-            vertices.push(m.to + shift);
-            lines.push(m.line);
-        }
-        report.extruding_moves = moves[a..=b].iter().filter(|m| m.de > 0.0).count();
-        if show {
-            let shown = layers::layers_hold(&vertices, &lines, limits, &mut report);
-            return Ok((report, shown));
-        }
-        layers::measure_layers(&vertices, &lines, limits, &mut report);
-    }
-    Ok((report, show))
 }
 
 /// Measures an extruding path (layer heights, overhang, support, holder collision) given as

@@ -13,8 +13,9 @@
 
 use glam::{DVec2, DVec3};
 
-/// Chords in a leaf box.
+/// Chords in a leaf box (at most 8: a byte says which of them the tree holds).
 const LEAF: usize = 8;
+const _: () = assert!(LEAF <= 8);
 
 /// A box around chords: x, y, z from `lo` to `hi`, in single precision rounded outward (it
 /// holds every point of its chords exactly); empty when `lo > hi`.
@@ -67,6 +68,8 @@ pub(super) struct ChordTree {
     /// The highest z of leaves `0 ..= i` (non-decreasing): the leaves before the first at or
     /// above a band lie wholly below it (on a rising wall, every leaf but the last few layers').
     top: Vec<f32>,
+    /// Which chords of each leaf the search holds, one bit each.
+    held: Vec<u8>,
 }
 
 impl ChordTree {
@@ -77,16 +80,19 @@ impl ChordTree {
         chords: &[(usize, usize)],
         held: &(impl Fn(usize) -> bool + Sync),
     ) -> ChordTree {
-        let leaves = crate::parallel::map_ranges(chords.len().div_ceil(LEAF), 4096, |range| {
+        let built = crate::parallel::map_ranges(chords.len().div_ceil(LEAF), 4096, |range| {
             range
                 .map(|leaf| {
                     let ids = leaf * LEAF..(leaf * LEAF + LEAF).min(chords.len());
-                    ids.filter(|&id| held(id)).fold(Bounds::EMPTY, |b, id| {
-                        b.join(Bounds::of(v[chords[id].0], v[chords[id].1]))
-                    })
+                    ids.filter(|&id| held(id))
+                        .fold((Bounds::EMPTY, 0u8), |(b, bits), id| {
+                            let (a, c) = (v[chords[id].0], v[chords[id].1]);
+                            (b.join(Bounds::of(a, c)), bits | 1 << (id % LEAF))
+                        })
                 })
                 .collect()
         });
+        let (leaves, held): (Vec<Bounds>, Vec<u8>) = built.into_iter().unzip();
         let top = leaves
             .iter()
             .scan(f32::NEG_INFINITY, |t, b: &Bounds| {
@@ -102,7 +108,12 @@ impl ChordTree {
                 .collect();
             levels.push(joined);
         }
-        ChordTree { levels, top }
+        ChordTree { levels, top, held }
+    }
+
+    /// Whether the tree holds chord `id` (the `held` it was built with).
+    pub(super) fn holds(&self, id: usize) -> bool {
+        self.held[id / LEAF] >> (id % LEAF) & 1 == 1
     }
 
     /// Calls `f` with the id of each of the first `laid` chords whose leaf box comes within
@@ -242,6 +253,7 @@ mod tests {
                 })
                 .collect();
             assert!(want.iter().all(|id| seen.contains(id)), "{j} {r}");
+            assert!((0..chords.len()).all(|id| tree.holds(id) == held(id)));
             if r < 5.0 {
                 assert!(seen.len() < laid / 10, "{j}: {} of {laid}", seen.len());
             }
