@@ -299,16 +299,22 @@ pub fn build_toolpath_on(
     let wall_start = b.points.len();
     let mut revolutions = 1;
 
-    // 3. The helix: revolution k goes from section k to k+1, turn t of it along bead t.
+    // 3. The helix: revolution k goes from section k to k+1, turn t of it along bead t. Each
+    //    turn's arc fractions first, on every core (they need only the sections).
     let share = 1.0 / walls as f64;
+    let turns = (layers - first.min(layers)) * walls;
+    let fractions: Vec<Vec<f64>> = crate::parallel::map_ranges(turns, 64, |r| {
+        r.map(|turn| arc_fractions(&beads[turn % walls][first + turn / walls]))
+            .collect()
+    });
+    let mut z_now = vec![0.0; n];
     for k in first..layers {
         let start = b.points.len();
         layer_starts.push(start);
         for (t, bead) in beads.iter().enumerate() {
             let (lo, hi) = (&bead[k], &bead[k + 1]);
-            let frac = arc_fractions(lo);
+            let frac = &fractions[(k - first) * walls + t];
             let below = &mut z_below[t];
-            let mut z_now = vec![0.0; n];
             z_now[0] = below[0];
             for i in from..=n {
                 let f = (t as f64 + frac[i]) * share;
@@ -343,7 +349,7 @@ pub fn build_toolpath_on(
                     z_now[j] = z;
                 }
             }
-            *below = z_now;
+            std::mem::swap(below, &mut z_now);
         }
         apply_min_layer_time(&mut b.points, start, p.min_layer_time);
         revolutions += 1;
