@@ -77,11 +77,6 @@ const SERIAL_BELOW: usize = 20_000;
 /// such moves take `len / v` directly). Each move's length and entry limit are found on every
 /// core; the two look-ahead passes, and the sum, in path order on one.
 pub fn plan_time(start: DVec3, moves: &[Move], a: f64, deviation: f64) -> f64 {
-    plan_time_of(start, moves, a, deviation)
-}
-
-/// [`plan_time`] of moves read by index (no list of them is built).
-pub fn plan_time_of(start: DVec3, moves: &(impl Moves + ?Sized), a: f64, deviation: f64) -> f64 {
     plan_time_in(start, moves, a, deviation, SERIAL_BELOW)
 }
 
@@ -93,61 +88,113 @@ fn plan_time_in(
     deviation: f64,
     serial_below: usize,
 ) -> f64 {
-    if a.is_nan() || a <= 0.0 {
-        return 0.0;
+    Plan::new_in(start, moves, a, deviation, serial_below).time()
+}
+
+/// A plan half done: each move's length, speed and entry limit, found on every core;
+/// [`Plan::time`] makes the look-ahead passes on one. Apart, so that a caller can use the second
+/// core for other work during the passes.
+pub struct Plan {
+    a: f64,
+    len: Vec<f64>,
+    speed: Vec<f64>,
+    /// `entry2[i]`: squared speed entering move i; `entry2[n]` = 0 (the job ends at rest).
+    entry2: Vec<f64>,
+}
+
+impl Plan {
+    /// The entry limits of `moves` starting at rest at `start` (see [`plan_time`]).
+    pub fn new(start: DVec3, moves: &(impl Moves + ?Sized), a: f64, deviation: f64) -> Plan {
+        Self::new_in(start, moves, a, deviation, SERIAL_BELOW)
     }
-    let n = moves.len();
-    let two_a = 2.0 * a;
-    let (mut len, mut speed) = (vec![0.0; n], vec![0.0; n]);
-    // entry2[i]: squared speed entering move i; entry2[n] = 0 (the job ends at rest).
-    let mut entry2 = vec![0.0; n + 1];
-    let parts = crate::parallel::ranges(n, serial_below);
-    {
-        let (mut len, mut speed, mut entry2) = (&mut len[..], &mut speed[..], &mut entry2[..n]);
-        let mut jobs = Vec::with_capacity(parts.len());
-        for range in &parts {
-            let (l, rest_l) = std::mem::take(&mut len).split_at_mut(range.len());
-            let (s, rest_s) = std::mem::take(&mut speed).split_at_mut(range.len());
-            let (e, rest_e) = std::mem::take(&mut entry2).split_at_mut(range.len());
-            (len, speed, entry2) = (rest_l, rest_s, rest_e);
-            let legs = Legs {
-                len: l,
-                speed: s,
-                entry2: e,
+
+    fn new_in(
+        start: DVec3,
+        moves: &(impl Moves + ?Sized),
+        a: f64,
+        deviation: f64,
+        serial_below: usize,
+    ) -> Plan {
+        if a.is_nan() || a <= 0.0 {
+            return Plan {
+                a,
+                len: Vec::new(),
+                speed: Vec::new(),
+                entry2: Vec::new(),
             };
-            let range = range.clone();
-            jobs.push(move || entry_limits(start, moves, range, legs, a, deviation));
         }
-        crate::parallel::run_parts(jobs);
+        let n = moves.len();
+        let (mut len, mut speed) = (vec![0.0; n], vec![0.0; n]);
+        let mut entry2 = vec![0.0; n + 1];
+        let parts = crate::parallel::ranges(n, serial_below);
+        {
+            let (mut len, mut speed, mut entry2) = (&mut len[..], &mut speed[..], &mut entry2[..n]);
+            let mut jobs = Vec::with_capacity(parts.len());
+            for range in &parts {
+                let (l, rest_l) = std::mem::take(&mut len).split_at_mut(range.len());
+                let (s, rest_s) = std::mem::take(&mut speed).split_at_mut(range.len());
+                let (e, rest_e) = std::mem::take(&mut entry2).split_at_mut(range.len());
+                (len, speed, entry2) = (rest_l, rest_s, rest_e);
+                let legs = Legs {
+                    len: l,
+                    speed: s,
+                    entry2: e,
+                };
+                let range = range.clone();
+                jobs.push(move || entry_limits(start, moves, range, legs, a, deviation));
+            }
+            crate::parallel::run_parts(jobs);
+        }
+        Plan {
+            a,
+            len,
+            speed,
+            entry2,
+        }
     }
-    // Backward pass: every move can still slow down to the next entry speed.
-    for i in (0..n).rev() {
-        let reach = entry2[i + 1] + two_a * len[i];
-        if entry2[i] > reach {
-            entry2[i] = reach;
+
+    /// The total time, s: the look-ahead passes and the sum, in path order.
+    pub fn time(self) -> f64 {
+        let Plan {
+            a,
+            len,
+            speed,
+            mut entry2,
+        } = self;
+        if a.is_nan() || a <= 0.0 {
+            return 0.0;
         }
+        let n = len.len();
+        let two_a = 2.0 * a;
+        // Backward pass: every move can still slow down to the next entry speed.
+        for i in (0..n).rev() {
+            let reach = entry2[i + 1] + two_a * len[i];
+            if entry2[i] > reach {
+                entry2[i] = reach;
+            }
+        }
+        // Forward pass: acceleration from the previous entry limits this one. Once it has limited
+        // move i's exit (the next entry), both ends of move i are final: its time is added then.
+        let mut total = 0.0;
+        let (mut v_last, mut inv_v) = (f64::NAN, 0.0);
+        for i in 0..n {
+            let reach = entry2[i] + two_a * len[i];
+            if entry2[i + 1] > reach {
+                entry2[i + 1] = reach;
+            }
+            let v = speed[i];
+            if v != v_last {
+                (v_last, inv_v) = (v, 1.0 / v);
+            }
+            let v2 = v * v;
+            total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
+                len[i] * inv_v // cruising all the way
+            } else {
+                trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
+            };
+        }
+        total
     }
-    // Forward pass: acceleration from the previous entry limits this one. Once it has limited
-    // move i's exit (the next entry), both ends of move i are final: its time is added then.
-    let mut total = 0.0;
-    let (mut v_last, mut inv_v) = (f64::NAN, 0.0);
-    for i in 0..n {
-        let reach = entry2[i] + two_a * len[i];
-        if entry2[i + 1] > reach {
-            entry2[i + 1] = reach;
-        }
-        let v = speed[i];
-        if v != v_last {
-            (v_last, inv_v) = (v, 1.0 / v);
-        }
-        let v2 = v * v;
-        total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
-            len[i] * inv_v // cruising all the way
-        } else {
-            trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
-        };
-    }
-    total
 }
 
 /// One part of the planner's per-move values.
