@@ -415,8 +415,13 @@ fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, F
             )));
         }
     }
-    pending.commit()?;
-    print_summary(&loaded, &job, Some(summary));
+    let replaced = pending.commit()?;
+    // The file replaced is freed on the second core while this one prints.
+    clayloft_core::parallel::both(
+        true,
+        move || drop(replaced),
+        || print_summary(&loaded, &job, Some(summary)),
+    );
     println!("wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
 }
