@@ -40,12 +40,12 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
 }
 
 /// Whether a G-code program keeps `limits`: `Ok(None)` when it does, shown without measuring
-/// every point's layers in full where a witness shows them (about half the time on a clay
+/// every point's layers in full where a witness shows them (about a fifth of the time on a clay
 /// vessel; see `layers::layers_hold`), else `Ok(Some(report))` with [`check_gcode`]'s
 /// report of what breaks. What `clayloft gcode` asks of its own file before writing it. The
 /// verdict is [`check_gcode`]'s (tested), but for a file whose layers the full search would give
-/// up on (its candidate budget spent, "not measurable") while a witness shows every point: that
-/// file passes here.
+/// up on (its candidate budget spent or its grid too large to build, "not measurable") while a
+/// witness shows every point: that file passes here.
 pub fn verify_gcode(text: &str, limits: &Limits) -> Result<Option<CheckReport>, GcodeError> {
     validate(limits)?;
     let (moves, start) = parse_moves(text)?;
