@@ -7,9 +7,9 @@
 //! heights descends from the top, leaving out every box farther than the search radius or
 //! outside the band. On a rising wall that leaves the layers just under the point and the
 //! stretch of them nearest it: the boxes of older layers lie below the band, those of the bead
-//! just laid above it, and those across the vessel too far. Built in one pass (about a
-//! millisecond for the 720 × 300 vase), without the grid's columns, and it can grow as a path
-//! is read.
+//! just laid above it, and those across the vessel too far. Built in one pass over the chords
+//! on both cores (2 ms for the 720 × 300 vase, against 13 ms for the grid), and never too large
+//! to build: a search's cost is bounded by its budget instead.
 
 use glam::{DVec2, DVec3};
 
