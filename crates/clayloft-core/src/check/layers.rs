@@ -101,8 +101,8 @@ fn short_chord2(extent: f64, radius: f64) -> f32 {
 /// bisection (or a few steps from the last point's), instead of every chord of the column.
 ///
 /// With `top[i]` = max z_max over chords 0 ..= i and `bottom[i]` = min z_min over chords i ..,
-/// both non-decreasing: the chords before the first i with top[i] ≥ z_lo lie wholly below z_lo,
-/// and those from the first i with bottom[i] > z_hi on lie wholly above z_hi. On a spiral (z
+/// both non-decreasing: the chords before the first i with `top[i]` ≥ z_lo lie wholly below z_lo,
+/// and those from the first i with `bottom[i]` > z_hi on lie wholly above z_hi. On a spiral (z
 /// rising with the path) that leaves just the few layers within reach, whatever the height of
 /// the column; on any other path it leaves at least the chords the height test keeps.
 #[derive(Default)]

@@ -54,7 +54,7 @@ pub fn verify_gcode(text: &str, limits: &Limits) -> Result<Option<CheckReport>, 
 
 /// [`verify_gcode`] of a program as it is written: the text goes in through
 /// [`std::io::Write`] in pieces of any size and is read into moves as it comes
-/// ([`MoveReader`]), so that it need not be kept whole; [`GcodeVerifier::finish`] gives the
+/// (a move reader), so that it need not be kept whole; [`GcodeVerifier::finish`] gives the
 /// verdict. What `clayloft gcode` writes its file through.
 pub struct GcodeVerifier {
     reader: MoveReader,
