@@ -41,13 +41,8 @@ const PART_BYTES: usize = 1 << 20;
 fn parse_moves_in(text: &str, part_bytes: usize) -> Result<(Vec<Move>, DVec3), GcodeError> {
     let read = read_parts(text, part_bytes);
     let mut state = State::default();
-    let mut moves = Vec::with_capacity(read.iter().map(|p| p.moves.len()).sum());
-    let mut lines_before = 0;
-    for part in read {
-        let lines = part.lines;
-        part.resolve(&mut state, lines_before, &mut moves)?;
-        lines_before += lines;
-    }
+    let mut moves = Vec::new();
+    resolve_parts(read, &mut state, 0, &mut moves)?;
     Ok((moves, state.start.unwrap_or(DVec3::ZERO)))
 }
 
@@ -169,14 +164,10 @@ impl MoveReader {
             }
         };
         let cores = crate::parallel::cores();
-        for part in read_parts(text, self.part_bytes.max(text.len().div_ceil(cores))) {
-            let count = part.lines;
-            let resolved = part.resolve(&mut self.state, self.lines, &mut self.moves);
-            self.lines += count;
-            if let Err(e) = resolved {
-                self.error = Some(e);
-                return;
-            }
+        let parts = read_parts(text, self.part_bytes.max(text.len().div_ceil(cores)));
+        match resolve_parts(parts, &mut self.state, self.lines, &mut self.moves) {
+            Ok(lines) => self.lines += lines,
+            Err(e) => self.error = Some(e),
         }
     }
 }
@@ -206,6 +197,7 @@ struct Part {
 }
 
 /// The modal state, as the file sets it up to a line.
+#[derive(Clone, Copy)]
 struct State {
     pos: DVec3,
     e: f64,
@@ -247,17 +239,100 @@ impl State {
     }
 }
 
+/// Resolves `parts` (read from consecutive text, the first starting after `lines_before`
+/// lines) into `out` in order, as [`Part::resolve_into`] one after another would, and gives the
+/// number of lines read.
+///
+/// Where each part's starting state can be told from the raw moves before it
+/// ([`Part::state_after`]: no modal command, absolute positions, as in the body of a program
+/// the writer makes), those parts are resolved at the same time, one per core, each into its
+/// own stretch of `out`: the moves are copied out and their pages faulted in on both cores.
+fn resolve_parts(
+    mut parts: Vec<Part>,
+    state: &mut State,
+    lines_before: usize,
+    out: &mut Vec<Move>,
+) -> Result<usize, GcodeError> {
+    out.reserve(parts.iter().map(|p| p.moves.len()).sum());
+    // The parts from `together` on change no mode but perhaps the last: they can start
+    // together once the ones before are resolved (if positions are absolute then).
+    let last = parts.len().saturating_sub(1);
+    let together = parts[..last]
+        .iter()
+        .rposition(|p| !p.modal.is_empty())
+        .map_or(0, |k| k + 1);
+    let later = parts.split_off(together);
+    let mut lines = lines_before;
+    for part in parts {
+        let count = part.lines;
+        let (written, result) = part.resolve_into(state, lines, out.spare_capacity_mut());
+        // SAFETY: `resolve_into` initialised the first `written` slots of the spare capacity.
+        unsafe { out.set_len(out.len() + written) };
+        result?;
+        lines += count;
+    }
+    if later.len() < 2 || !state.absolute_xyz {
+        for part in later {
+            let count = part.lines;
+            let (written, result) = part.resolve_into(state, lines, out.spare_capacity_mut());
+            // SAFETY: as above.
+            unsafe { out.set_len(out.len() + written) };
+            result?;
+            lines += count;
+        }
+        return Ok(lines - lines_before);
+    }
+    // Each part's starting state and first line, then one stretch of the spare capacity each.
+    let len = out.len();
+    let mut spare = &mut out.spare_capacity_mut()[..];
+    let mut jobs = Vec::with_capacity(later.len());
+    let mut ahead = *state;
+    for part in later {
+        let first_line = lines;
+        lines += part.lines;
+        let mut start = ahead;
+        // Told for every part but the last (it changes no mode; positions stay absolute).
+        let after = part.state_after(&ahead);
+        debug_assert!(after.is_some() || jobs.len() + 1 == jobs.capacity());
+        ahead = after.unwrap_or(ahead);
+        let (stretch, rest) = std::mem::take(&mut spare).split_at_mut(part.moves.len());
+        spare = rest;
+        jobs.push(move || {
+            let (written, result) = part.resolve_into(&mut start, first_line, stretch);
+            (written, result, start)
+        });
+    }
+    let mut written_total = 0;
+    let mut outcome = Ok(lines - lines_before);
+    for (written, result, end) in crate::parallel::run_parts(jobs) {
+        written_total += written;
+        *state = end;
+        if let Err(e) = result {
+            outcome = Err(e);
+            break;
+        }
+    }
+    // SAFETY: the parts before the first that failed wrote their whole stretches, and that one
+    // the first `written` slots of its own: `written_total` contiguous initialised moves.
+    unsafe { out.set_len(len + written_total) };
+    outcome
+}
+
 impl Part {
-    /// Applies the modal state to the part's moves in order and appends them to `out`, with
-    /// their lines counted from the file's start; `state` is left as the part leaves it.
-    fn resolve(
+    /// Applies the modal state to the part's moves in order, writing them to the start of
+    /// `out` (room for all of them) with their lines counted from the file's start; `state`
+    /// is left as the part leaves it. Gives how many moves were written (all but after an
+    /// error), with the part's first error.
+    fn resolve_into(
         self,
         state: &mut State,
         lines_before: usize,
-        out: &mut Vec<Move>,
-    ) -> Result<(), GcodeError> {
+        out: &mut [std::mem::MaybeUninit<Move>],
+    ) -> (usize, Result<(), GcodeError>) {
+        let count = self.moves.len();
+        assert!(out.len() >= count, "room for every move of the part");
         let mut modal = self.modal.iter().peekable();
-        for (k, m) in self.moves.into_iter().enumerate() {
+        for ((k, m), slot) in self.moves.into_iter().enumerate().zip(out.iter_mut()) {
             while let Some((_, change)) = modal.next_if(|(at, _)| *at == k) {
                 state.apply(*change);
             }
@@ -279,25 +354,59 @@ impl Part {
                 v => v,
             };
             if !to.is_finite() {
-                return Err(GcodeError {
+                let error = GcodeError {
                     line,
                     message: "the position runs past any finite number".into(),
-                });
+                };
+                return (k, Err(error));
             }
             state.start.get_or_insert(state.pos);
-            out.push(Move { to, de, line });
+            slot.write(Move { to, de, line });
             state.pos = to;
         }
         for (_, change) in modal {
             state.apply(*change);
         }
         match self.error {
-            Some(e) => Err(GcodeError {
-                line: e.line + lines_before,
-                ..e
-            }),
-            None => Ok(()),
+            Some(e) => (
+                count,
+                Err(GcodeError {
+                    line: e.line + lines_before,
+                    ..e
+                }),
+            ),
+            None => (count, Ok(())),
         }
+    }
+
+    /// The state [`Part::resolve_into`] leaves, from `state`, told without resolving the moves:
+    /// where the part changes no mode and its X, Y and Z are absolute, each axis ends at the
+    /// last value given for it (E too, when absolute). None otherwise.
+    fn state_after(&self, state: &State) -> Option<State> {
+        if !self.modal.is_empty() || !state.absolute_xyz {
+            return None;
+        }
+        let mut after = *state;
+        let mut missing = [true; 4];
+        for m in self.moves.iter().rev() {
+            for (c, v) in [m.to.x, m.to.y, m.to.z, m.de].into_iter().enumerate() {
+                if missing[c] && !v.is_nan() {
+                    missing[c] = false;
+                    match c {
+                        3 if state.absolute_e => after.e = v,
+                        3 => {}
+                        _ => after.pos[c] = v,
+                    }
+                }
+            }
+            if missing == [false; 4] {
+                break;
+            }
+        }
+        if !self.moves.is_empty() {
+            after.start = Some(state.start.unwrap_or(state.pos));
+        }
+        Some(after)
     }
 }
 
@@ -622,6 +731,37 @@ mod tests {
         ]
     }
 
+    /// A line a program's body may hold after its set-up: any line of [`gcode_line`] but the
+    /// ones that change a mode (G90/G91, M82/M83, G92, G28), whose parts are resolved at the
+    /// same time.
+    fn body_line() -> impl Strategy<Value = String> {
+        gcode_line().prop_filter("changes no mode", |l| {
+            !["G9", "M8", "G28"].iter().any(|c| l.starts_with(c))
+        })
+    }
+
+    /// `text` read whole, in parts, and fed to the reader in pieces read whole or in parts:
+    /// each gives the moves, start and first error of the one-pass reader.
+    fn reads_as_the_whole_file(text: &str, part_bytes: usize) -> Result<(), TestCaseError> {
+        let reference = parse_moves_reference(text);
+        prop_assert_eq!(parse_moves_in(text, usize::MAX), reference.clone());
+        prop_assert_eq!(parse_moves_in(text, part_bytes), reference.clone());
+        // Fed to the reader in pieces cut anywhere (in a line, in a CRLF, in a number).
+        let mut reader = MoveReader::with_capacity(0);
+        for piece in text.as_bytes().chunks(part_bytes) {
+            reader.feed(piece);
+        }
+        prop_assert_eq!(reader.finish(), reference.clone());
+        // And each piece read in parts of its own.
+        let mut reader = MoveReader::with_capacity(0);
+        reader.part_bytes = 1 + part_bytes / 7;
+        for piece in text.as_bytes().chunks(part_bytes) {
+            reader.feed(piece);
+        }
+        prop_assert_eq!(reader.finish(), reference);
+        Ok(())
+    }
+
     proptest! {
         /// Read in parts of any size (or whole), a file gives the moves, start and first error of
         /// the one-pass reader: the modal state (relative moves and E, G92, G28) carries across
@@ -629,23 +769,16 @@ mod tests {
         /// pieces cut anywhere, each read whole or in parts.
         #[test]
         fn parts_read_as_the_whole_file(lines in proptest::collection::vec(gcode_line(), 0..60), part_bytes in 1usize..200, crlf in any::<bool>()) {
-            let text = lines.join(if crlf { "\r\n" } else { "\n" });
-            let reference = parse_moves_reference(&text);
-            prop_assert_eq!(parse_moves_in(&text, usize::MAX), reference.clone());
-            prop_assert_eq!(parse_moves_in(&text, part_bytes), reference.clone());
-            // Fed to the reader in pieces cut anywhere (in a line, in a CRLF, in a number).
-            let mut reader = MoveReader::with_capacity(0);
-            for piece in text.as_bytes().chunks(part_bytes) {
-                reader.feed(piece);
-            }
-            prop_assert_eq!(reader.finish(), reference.clone());
-            // And each piece read in parts of its own.
-            let mut reader = MoveReader::with_capacity(0);
-            reader.part_bytes = 1 + part_bytes / 7;
-            for piece in text.as_bytes().chunks(part_bytes) {
-                reader.feed(piece);
-            }
-            prop_assert_eq!(reader.finish(), reference);
+            reads_as_the_whole_file(&lines.join(if crlf { "\r\n" } else { "\n" }), part_bytes)?;
+        }
+
+        /// The same for a set-up of any lines and then a body that changes no mode, whose parts
+        /// are resolved at the same time, each from the state told from the parts before it:
+        /// relative or absolute E, axes left out, errors in any part.
+        #[test]
+        fn parts_resolved_together_read_as_the_whole_file(setup in proptest::collection::vec(gcode_line(), 0..4), body in proptest::collection::vec(body_line(), 0..80), part_bytes in 1usize..300) {
+            let lines: Vec<String> = setup.into_iter().chain(body).collect();
+            reads_as_the_whole_file(&lines.join("\n"), part_bytes)?;
         }
     }
 
