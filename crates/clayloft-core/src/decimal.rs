@@ -1,5 +1,6 @@
-//! Decimal text of G-code numbers: fixed-point, rounded half away from zero, written digit pair by
-//! digit pair into a line assembled on the stack; and read back ([`parse_f64`]).
+//! Decimal text of G-code numbers: fixed-point, rounded half away from zero, written three
+//! digits (or two) at a time into a line assembled on the stack; and read back ([`parse_f64`],
+//! [`decimal_prefix`]).
 //!
 //! A path point's line is about 40 bytes and five numbers; writing it word by word into the
 //! output costs a capacity check and a copy call per word, and a division by a power of ten that
@@ -12,6 +13,20 @@ const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
 4041424344454647484950515253545556575859\
 6061626364656667686970717273747576777879\
 8081828384858687888990919293949596979899";
+
+/// The three digits of 0 … 999 as the low three bytes of a word, lowest first ("007" is
+/// `b'0' | b'0' << 8 | b'7' << 16`): written into a line in one store.
+const TRIPLES: [u32; 1000] = {
+    let mut t = [0u32; 1000];
+    let mut i = 0;
+    while i < 1000 {
+        t[i] = (b'0' + (i / 100) as u8) as u32
+            | ((b'0' + (i / 10 % 10) as u8) as u32) << 8
+            | ((b'0' + (i % 10) as u8) as u32) << 16;
+        i += 1;
+    }
+    t
+};
 
 /// Most decimals a number is written with (`10^MAX_DECIMALS` fits the fast path's integers).
 pub const MAX_DECIMALS: u32 = 6;
@@ -96,12 +111,37 @@ impl Line {
             self.text(b"-");
         }
         let int = n / pow;
-        self.digits(int, int.checked_ilog10().map_or(1, |d| d as usize + 1));
-        if D > 0 {
-            self.text(b".");
-            self.digits(n % pow, D as usize);
+        if int < 1000 {
+            // One to three digits from one entry, the leading zeros shifted out.
+            let width = 1 + usize::from(int >= 10) + usize::from(int >= 100);
+            self.word(TRIPLES[int as usize] >> (8 * (3 - width)), width);
+        } else {
+            self.digits(int, int.checked_ilog10().map_or(1, |d| d as usize + 1));
+        }
+        let frac = n % pow;
+        match D {
+            0 => {}
+            // The point and three digits in one word.
+            3 => self.word(u32::from(b'.') | TRIPLES[frac as usize] << 8, 4),
+            // The point and five: three, then a pair.
+            5 => {
+                self.word(u32::from(b'.') | TRIPLES[(frac / 100) as usize] << 8, 4);
+                let pair = (frac % 100) as usize * 2;
+                self.text(&DIGIT_PAIRS[pair..pair + 2]);
+            }
+            _ => {
+                self.text(b".");
+                self.digits(frac, D as usize);
+            }
         }
         self
+    }
+
+    /// Appends the first `width` (at most 4) bytes of `word`, lowest first.
+    #[inline]
+    fn word(&mut self, word: u32, width: usize) {
+        self.bytes[self.len..self.len + 4].copy_from_slice(&word.to_le_bytes());
+        self.len += width;
     }
 
     /// Appends the last `width` decimal digits of `n` (zero-padded).
@@ -147,29 +187,66 @@ pub fn parse_f64(text: &str) -> Result<f64, std::num::ParseFloatError> {
 /// both are exact doubles, and one division rounds the quotient correctly (IEEE 754), as the
 /// standard parser does (Clinger's fast path): the same bits.
 pub fn plain_decimal(bytes: &[u8]) -> Option<f64> {
-    let (negative, digits) = match bytes.first() {
-        Some(b'-') => (true, &bytes[1..]),
-        Some(b'+') => (false, &bytes[1..]),
-        _ => (false, bytes),
-    };
-    let (mut m, mut count, mut after_point, mut point) = (0u64, 0usize, 0usize, false);
-    for &b in digits {
-        match b {
-            b'0'..=b'9' if count < 19 => {
-                m = m * 10 + u64::from(b - b'0');
-                count += 1;
-                after_point += usize::from(point);
-            }
-            b'.' if !point => point = true,
-            _ => return None,
-        }
+    match decimal_prefix(bytes)? {
+        (v, used) if used == bytes.len() => Some(v),
+        _ => None,
     }
-    if count == 0 || m >= 1 << 53 || after_point >= EXACT_POWERS.len() {
+}
+
+/// The plain decimal at the start of `bytes` (the longest run of an optional sign, digits and
+/// at most one point) read as [`plain_decimal`] reads it, and the bytes it takes; None where
+/// that would be None. For a reader that goes on after the number (a G-code word ends at a
+/// space) without finding its end first.
+pub fn decimal_prefix(bytes: &[u8]) -> Option<(f64, usize)> {
+    let (negative, sign) = match bytes.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    // The digits before the point, then those after it: two short runs, each read by a loop
+    // that only tests for a digit. More than 19 digits are left to the standard parser (the
+    // mantissa is then wrong, and refused below).
+    let run = |from: usize| {
+        let (mut m, mut i) = (0u64, from);
+        while let Some(d) = bytes
+            .get(i)
+            .map(|b| b.wrapping_sub(b'0'))
+            .filter(|&d| d < 10)
+        {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        (m, i)
+    };
+    let (whole, point) = run(sign);
+    let (m, end, after_point) = if bytes.get(point) == Some(&b'.') {
+        let (fraction, end) = run(point + 1);
+        let after = end - point - 1;
+        let m = whole
+            .wrapping_mul(POWERS_OF_TEN[after.min(19)])
+            .wrapping_add(fraction);
+        (m, end, after)
+    } else {
+        (whole, point, 0)
+    };
+    let count = end - sign - usize::from(end > point);
+    if count == 0 || count > 19 || m >= 1 << 53 || after_point >= EXACT_POWERS.len() {
         return None;
     }
     let v = m as f64 / EXACT_POWERS[after_point];
-    Some(if negative { -v } else { v })
+    Some((if negative { -v } else { v }, end))
 }
+
+/// 10⁰ … 10¹⁹ as integers.
+const POWERS_OF_TEN: [u64; 20] = {
+    let mut t = [1u64; 20];
+    let mut i = 1;
+    while i < 20 {
+        t[i] = t[i - 1] * 10;
+        i += 1;
+    }
+    t
+};
 
 /// Appends `v` with exactly `decimals` digits after the point to `buf` (see [`Line::fixed`]).
 pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
@@ -247,6 +324,16 @@ mod tests {
                 match (parse_f64(t), t.parse::<f64>()) {
                     (Ok(a), Ok(b)) => proptest::prop_assert_eq!(a.to_bits(), b.to_bits(), "{:?}", t),
                     (a, b) => proptest::prop_assert_eq!(a.is_ok(), b.is_ok(), "{:?}", t),
+                }
+                // Read as the start of a word (with more after it), a plain decimal is the same
+                // number and ends where it ends; anything else stops short or is refused.
+                let followed = format!("{t} Y1.5");
+                match (plain_decimal(t.as_bytes()), decimal_prefix(followed.as_bytes())) {
+                    (Some(a), Some((b, used))) => {
+                        proptest::prop_assert_eq!((a.to_bits(), used), (b.to_bits(), t.len()), "{:?}", t)
+                    }
+                    (Some(_), None) => proptest::prop_assert!(false, "{:?} refused", t),
+                    (None, prefix) => proptest::prop_assert!(prefix.is_none_or(|(_, used)| used < t.len()), "{:?}", t),
                 }
             }
         }

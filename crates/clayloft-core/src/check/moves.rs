@@ -469,7 +469,9 @@ fn plain_move(raw: &[u8]) -> Option<[f64; 4]> {
         .or_else(|| raw.strip_prefix(b"G0 "))?;
     let mut given = [f64::NAN; 5];
     let mut seen = [false; 5];
-    for word in rest.split(|&b| b == b' ') {
+    // Word by word: a letter, a number read up to where it ends, then a space or the end.
+    let mut word = rest;
+    loop {
         let (&letter, number) = word.split_first()?;
         let slot = match letter {
             b'X' => 0,
@@ -482,7 +484,13 @@ fn plain_move(raw: &[u8]) -> Option<[f64; 4]> {
         if std::mem::replace(&mut seen[slot], true) {
             return None;
         }
-        given[slot] = crate::decimal::plain_decimal(number)?;
+        let (v, used) = crate::decimal::decimal_prefix(number)?;
+        given[slot] = v;
+        match number.get(used) {
+            None => break,
+            Some(b' ') => word = &number[used + 1..],
+            Some(_) => return None,
+        }
     }
     Some([given[0], given[1], given[2], given[3]])
 }
