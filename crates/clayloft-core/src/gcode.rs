@@ -128,10 +128,10 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
     summarize_beside(design, job, false, || ()).0
 }
 
-/// [`summarize`], with `beside` run on a second core (when `use_beside` and one is free) while
-/// the motion planner's look-ahead passes and the clay's volume use this one (its entry limits
-/// use both cores first): the writer's thumbnails (9.3 → 6 ms for the two on the benchmark
-/// vase, against the thumbnails beside the whole planner).
+/// [`summarize`], with `beside` and the path's length run on a second core (when `use_beside`
+/// and one is free) while the motion planner's look-ahead passes and the clay's volume use this
+/// one (its entry limits use both cores first): the writer's thumbnails (9.3 → 6 ms for the two
+/// on the benchmark vase, against the thumbnails beside the whole planner) and print time.
 fn summarize_beside<T: Send>(
     design: &Design,
     job: &PrintJob,
@@ -142,17 +142,22 @@ fn summarize_beside<T: Send>(
     let tp = &job.toolpath;
     let moves = JobMoves::new(design, tp);
     let plan = motion::Plan::new(moves.home, &moves, p.max_acceleration, p.junction_deviation);
-    let (other, (time, volume)) = crate::parallel::both(use_beside, beside, || {
-        let volume: f64 = (1..tp.points.len())
-            .map(|i| segment_volume(design, tp, i))
-            .sum();
-        (plan.time(), volume)
-    });
+    // The path's length (a pass over it) goes with the work beside.
+    let ((other, length), (time, volume)) = crate::parallel::both(
+        use_beside,
+        || (beside(), tp.length()),
+        || {
+            let volume: f64 = (1..tp.points.len())
+                .map(|i| segment_volume(design, tp, i))
+                .sum();
+            (plan.time(), volume)
+        },
+    );
     let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
     let summary = JobSummary {
         layers: job.surface.layers,
         points: tp.points.len(),
-        path_length_mm: tp.length(),
+        path_length_mm: length,
         estimated_time_s: time,
         volume_mm3: volume,
         e_length_mm: volume * p.flow_multiplier / feed_area,
@@ -348,14 +353,16 @@ fn write_program_indexed(
 ) -> Result<JobSummary, GcodeWriteError> {
     let p = &design.printer;
     let tp = &job.toolpath;
-    // The thumbnails are drawn beside the motion planner's passes (the time estimate).
-    let (summary, thumbnails) = summarize_beside(design, job, p.thumbnail, || {
-        p.thumbnail.then(|| {
+    // The thumbnails and the print time at nominal speeds (the body's progress is of it) are
+    // worked out beside the motion planner's passes (the time estimate).
+    let (summary, (thumbnails, nominal_s)) = summarize_beside(design, job, true, || {
+        let thumbnails = p.thumbnail.then(|| {
             // Thinned to what a thumbnail draws: no copy of the whole path.
             let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
             let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
             crate::thumbnail::header_blocks(&points)
-        })
+        });
+        (thumbnails, tp.print_time())
     });
     let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
@@ -525,7 +532,12 @@ fn write_program_indexed(
     }
     out.write_all(&buf)?;
     buf.clear();
-    let body = BodyWriter::new(design, tp, summary.estimated_time_s, layers_total);
+    let body = BodyWriter::new(
+        design,
+        tp,
+        (nominal_s, summary.estimated_time_s),
+        layers_total,
+    );
     body.write(out, &mut index)?;
     if !tp.points.is_empty() {
         buf.extend_from_slice(b"G0 Z");
@@ -595,10 +607,17 @@ struct BodyWriter<'a> {
 }
 
 impl<'a> BodyWriter<'a> {
-    fn new(design: &'a Design, tp: &'a Toolpath, planned_s: f64, layers_total: usize) -> Self {
+    /// The writer of `tp`'s body, whose print time is `nominal_s` at the points' speeds
+    /// ([`Toolpath::print_time`]) and `planned_s` as planned.
+    fn new(
+        design: &'a Design,
+        tp: &'a Toolpath,
+        (nominal_s, planned_s): (f64, f64),
+        layers_total: usize,
+    ) -> Self {
         let p = &design.printer;
         let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
-        let nominal = tp.print_time().max(1e-9);
+        let nominal = nominal_s.max(1e-9);
         BodyWriter {
             design,
             tp,
@@ -821,7 +840,7 @@ mod tests {
             revolutions: 1,
             findings: Vec::new(),
         };
-        let body = BodyWriter::new(&d, &tp, 12_345.0, tp.layer_starts.len());
+        let body = BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
         let (mut text, mut index) = (Vec::new(), Vec::new());
         body.write(&mut text, &mut Some(&mut index)).unwrap();
         let mut whole = (Vec::new(), Vec::new());

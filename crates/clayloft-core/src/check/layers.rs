@@ -565,29 +565,31 @@ fn measure_layers_in(
     } else {
         Vec::new()
     };
-    let (mut thin, mut thick, mut lean, mut unsupported, mut collide) = (
-        Tally::default(),
+    let (mut thin, mut thick, mut lean, mut unsupported) = (
         Tally::default(),
         Tally::default(),
         Tally::default(),
         Tally::default(),
     );
+    let mut clearance = Clearance {
+        highest: f64::NEG_INFINITY,
+        max_rise: report.max_rise_above_tip,
+        limit: limits.nozzle_length + 1e-6,
+        collide: Tally::default(),
+    };
     report.min_layer_height = f64::INFINITY;
-    let mut running_max_z = f64::NEG_INFINITY;
-    for j in 0..v.len() {
+    // With no layers to tally, the clearance alone, in one tight pass; else point by point.
+    let tallied = if below.is_empty() {
+        for (p, &line) in v.iter().zip(lines) {
+            clearance.add(p.z, line, &mut report.events);
+        }
+        0
+    } else {
+        v.len()
+    };
+    for j in 0..tallied {
         let p = v[j];
-        if running_max_z - p.z > report.max_rise_above_tip {
-            report.max_rise_above_tip = running_max_z - p.z;
-        }
-        if running_max_z - p.z > limits.nozzle_length + 1e-6 {
-            collide.add(running_max_z - p.z, lines[j]);
-            report.events.push(PathEvent {
-                line: lines[j],
-                what: COLLISION,
-                value: running_max_z - p.z,
-            });
-        }
-        running_max_z = running_max_z.max(p.z);
+        clearance.add(p.z, lines[j], &mut report.events);
         let Some(&below) = below.get(j).filter(|_| measurable) else {
             continue;
         };
@@ -674,8 +676,9 @@ fn measure_layers_in(
         UNSUPPORTED,
         format!("no printed layer within {radius:.1} mm below (worst = z, mm)"),
     );
+    report.max_rise_above_tip = clearance.max_rise;
     push(
-        collide,
+        clearance.collide,
         COLLISION,
         format!(
             "printed part rises above the holder, nozzle_length {} mm (worst = mm)",
@@ -683,6 +686,37 @@ fn measure_layers_in(
         ),
     );
     shown
+}
+
+/// The holder's clearance along the path: how far the part printed rises above the point
+/// printing (the highest point so far, over it), and where that is more than the nozzle's
+/// length (the holder hits the part).
+struct Clearance {
+    highest: f64,
+    max_rise: f64,
+    /// The nozzle's length, with a tolerance.
+    limit: f64,
+    collide: Tally,
+}
+
+impl Clearance {
+    /// The next point of the path, at height `z` on `line`.
+    #[inline]
+    fn add(&mut self, z: f64, line: usize, events: &mut Vec<PathEvent>) {
+        let rise = self.highest - z;
+        if rise > self.max_rise {
+            self.max_rise = rise;
+        }
+        if rise > self.limit {
+            self.collide.add(rise, line);
+            events.push(PathEvent {
+                line,
+                what: COLLISION,
+                value: rise,
+            });
+        }
+        self.highest = self.highest.max(z);
+    }
 }
 
 /// The grid columns around the last point searched, each with its run for that point (the
