@@ -389,7 +389,8 @@ impl GridPart {
 /// long, whatever its sampling; a hostile file that zig-zags in one spot stays one chord per
 /// point but its cells are capped.
 pub(super) fn chords(v: &[DVec3]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
+    // Room for a chord a segment (pages are only taken as written): no copies as it grows.
+    let mut out = Vec::with_capacity(v.len().saturating_sub(1));
     let mut i = 0;
     while i + 1 < v.len() {
         let mut k = i + 1;
