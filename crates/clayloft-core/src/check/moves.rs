@@ -262,25 +262,9 @@ fn resolve_parts(
         .rposition(|p| !p.modal.is_empty())
         .map_or(0, |k| k + 1);
     let later = parts.split_off(together);
-    let mut lines = lines_before;
-    for part in parts {
-        let count = part.lines;
-        let (written, result) = part.resolve_into(state, lines, out.spare_capacity_mut());
-        // SAFETY: `resolve_into` initialised the first `written` slots of the spare capacity.
-        unsafe { out.set_len(out.len() + written) };
-        result?;
-        lines += count;
-    }
+    let mut lines = resolve_in_turn(parts, state, lines_before, out)?;
     if later.len() < 2 || !state.absolute_xyz {
-        for part in later {
-            let count = part.lines;
-            let (written, result) = part.resolve_into(state, lines, out.spare_capacity_mut());
-            // SAFETY: as above.
-            unsafe { out.set_len(out.len() + written) };
-            result?;
-            lines += count;
-        }
-        return Ok(lines - lines_before);
+        return Ok(resolve_in_turn(later, state, lines, out)? - lines_before);
     }
     // Each part's starting state and first line, then one stretch of the spare capacity each.
     let len = out.len();
@@ -316,6 +300,25 @@ fn resolve_parts(
     // the first `written` slots of its own: `written_total` contiguous initialised moves.
     unsafe { out.set_len(len + written_total) };
     outcome
+}
+
+/// Resolves `parts` one after another into `out` (room reserved), the first starting after
+/// `lines` lines; gives the lines read up to the end of the last.
+fn resolve_in_turn(
+    parts: Vec<Part>,
+    state: &mut State,
+    mut lines: usize,
+    out: &mut Vec<Move>,
+) -> Result<usize, GcodeError> {
+    for part in parts {
+        let count = part.lines;
+        let (written, result) = part.resolve_into(state, lines, out.spare_capacity_mut());
+        // SAFETY: `resolve_into` initialised the first `written` slots of the spare capacity.
+        unsafe { out.set_len(out.len() + written) };
+        result?;
+        lines += count;
+    }
+    Ok(lines)
 }
 
 impl Part {
