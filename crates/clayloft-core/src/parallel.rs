@@ -5,7 +5,7 @@
 //! **Helper threads.** Parts run on the calling thread and on `cores − 1` helper threads that
 //! live as long as the process. A thread started for each part cost about 50 µs here, and a
 //! sleeping thread about as much to wake (a virtual machine's idle core is halted): more than
-//! many parts take. So a helper that has finished a part keeps spinning for [`LINGER`] before it
+//! many parts take. So a helper that has finished a part keeps spinning for `LINGER` (200 µs) before it
 //! sleeps, and inside [`awake`] (a session update, a whole command) it spins until the end: a
 //! part handed over starts within a microsecond. A part is handed to a free helper or, when
 //! none is free (a part started from a part, or two threads at once), run on the calling thread:
@@ -269,8 +269,9 @@ pub fn beside<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> Besi
 /// is about to fill) while this thread goes on, so that its writes find them mapped: a page's
 /// first write costs about a microsecond here (the fault, the page zeroed), 3 ms for the
 /// benchmark vase's 10 MB toolpath. Only a hint: nothing is done where no helper is free, or
-/// where the system has no such call. The buffer is not touched (see [`populate`]), so it may
-/// be written, grown or freed meanwhile; joining waits for the helper.
+/// where the system has no such call. The buffer is not touched (`MADV_POPULATE_WRITE` maps
+/// pages without writing), so it may be written, grown or freed meanwhile; joining waits for
+/// the helper.
 pub fn fault_in_spare<T>(v: &Vec<T>) -> Beside<()> {
     let size = std::mem::size_of::<T>();
     let start = v.as_ptr() as usize + v.len() * size;
