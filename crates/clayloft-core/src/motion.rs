@@ -23,6 +23,19 @@ pub struct Move {
     pub speed: f64,
 }
 
+/// Time of a move of length `len` entered and left at squared speeds `entry2` (feasible), at
+/// top speed `v` (`inv_v` = 1/v, kept by the caller across moves of one speed): `len/v` when
+/// it cruises all the way, else [`trapezoid_time`].
+#[inline]
+fn move_time(len: f64, (in2, out2): (f64, f64), (v, inv_v): (f64, f64), a: f64) -> f64 {
+    let v2 = v * v;
+    if in2 >= v2 && out2 >= v2 {
+        len * inv_v
+    } else {
+        trapezoid_time(len, in2.sqrt(), out2.sqrt(), v, a)
+    }
+}
+
 /// Time of a move of length `len` from speed `v0` to `v1` with top speed `vmax` and
 /// acceleration `a` (all speeds already feasible: `|v1² − v0²| ≤ 2·a·len`).
 pub fn trapezoid_time(len: f64, v0: f64, v1: f64, vmax: f64, a: f64) -> f64 {
@@ -186,12 +199,7 @@ impl Plan {
             if v != v_last {
                 (v_last, inv_v) = (v, 1.0 / v);
             }
-            let v2 = v * v;
-            total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
-                len[i] * inv_v // cruising all the way
-            } else {
-                trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
-            };
+            total += move_time(len[i], (entry2[i], entry2[i + 1]), (v, inv_v), a);
         }
         total
     }
@@ -389,12 +397,7 @@ mod tests {
             if v != v_last {
                 (v_last, inv_v) = (v, 1.0 / v);
             }
-            let v2 = v * v;
-            total += if entry2[i] >= v2 && entry2[i + 1] >= v2 {
-                len[i] * inv_v // cruising all the way
-            } else {
-                trapezoid_time(len[i], entry2[i].sqrt(), entry2[i + 1].sqrt(), v, a)
-            };
+            total += move_time(len[i], (entry2[i], entry2[i + 1]), (v, inv_v), a);
         }
         total
     }
