@@ -128,10 +128,11 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
     summarize_beside(design, job, false, || ()).0
 }
 
-/// [`summarize`], with `beside` and the path's length run on a second core (when `use_beside`
-/// and one is free) while the motion planner's look-ahead passes and the clay's volume use this
-/// one (its entry limits use both cores first): the writer's thumbnails (9.3 → 6 ms for the two
-/// on the benchmark vase, against the thumbnails beside the whole planner) and print time.
+/// [`summarize`], with `beside` (the writer's thumbnails and print time) and the path's length
+/// run on a second core (when `use_beside` and one is free) while the motion planner's
+/// look-ahead passes and the clay's volume use this one (its entry limits use both cores
+/// first). For the benchmark vase the thumbnails and the estimate took 9.3 ms with the
+/// thumbnails beside the whole planner, 6 ms so.
 fn summarize_beside<T: Send>(
     design: &Design,
     job: &PrintJob,

@@ -269,15 +269,16 @@ fn resolve_parts(
     // Each part's starting state and first line, then one stretch of the spare capacity each.
     let len = out.len();
     let mut spare = &mut out.spare_capacity_mut()[..];
+    let last = later.len() - 1;
     let mut jobs = Vec::with_capacity(later.len());
     let mut ahead = *state;
-    for part in later {
+    for (k, part) in later.into_iter().enumerate() {
         let first_line = lines;
         lines += part.lines;
         let mut start = ahead;
         // Told for every part but the last (it changes no mode; positions stay absolute).
         let after = part.state_after(&ahead);
-        debug_assert!(after.is_some() || jobs.len() + 1 == jobs.capacity());
+        debug_assert!(after.is_some() || k == last);
         ahead = after.unwrap_or(ahead);
         let (stretch, rest) = std::mem::take(&mut spare).split_at_mut(part.moves.len());
         spare = rest;
