@@ -244,21 +244,33 @@ pub fn point_leans_deg(sections: &[Section]) -> Vec<f32> {
     measure_with_leans(sections).1
 }
 
-/// Largest lean, z ranges and layer heights of a surface.
+/// Largest lean, z ranges and layer heights of a surface (without each point's lean: what
+/// the command line needs).
 pub fn measure(sections: &[Section]) -> SurfaceMetrics {
-    measure_with_leans(sections).0
+    measure_in_parts(sections, false).0
 }
 
-/// [`measure`] and [`point_leans_deg`] in one pass (the surface keeps both); the sections are
-/// measured in parts on the machine's cores and the parts merged (maxima and minima).
+/// [`measure`] and [`point_leans_deg`] in one pass (the surface of a session with a view keeps
+/// both).
 pub fn measure_with_leans(sections: &[Section]) -> (SurfaceMetrics, Vec<f32>) {
-    let parts =
-        crate::parallel::map_ranges(sections.len(), 64, |r| vec![measure_part(sections, r)]);
+    measure_in_parts(sections, true)
+}
+
+/// [`measure`], with each point's lean when `keep_leans`: the sections are measured in parts
+/// on the machine's cores and the parts merged (maxima and minima).
+fn measure_in_parts(sections: &[Section], keep_leans: bool) -> (SurfaceMetrics, Vec<f32>) {
+    let parts = crate::parallel::map_ranges(sections.len(), 64, |r| {
+        vec![measure_part(sections, r, keep_leans)]
+    });
     let mut m = SurfaceMetrics {
         min_layer_height: f64::INFINITY,
         ..Default::default()
     };
-    let mut leans = Vec::with_capacity(sections.iter().map(|s| s.points.len()).sum());
+    let mut leans = Vec::with_capacity(if keep_leans {
+        sections.iter().map(|s| s.points.len()).sum()
+    } else {
+        0
+    });
     for (part, part_leans) in parts {
         m.max_overhang_deg = m.max_overhang_deg.max(part.max_overhang_deg);
         m.max_layer_z_range = m.max_layer_z_range.max(part.max_layer_z_range);
@@ -310,26 +322,35 @@ fn atan_nonnegative(x: f64) -> f64 {
     base + (x * (z * p / q) + x + extra)
 }
 
-/// The metrics and leans of sections `range` (section 0, on the bed, leans 0 and bounds no
-/// layer).
+/// The metrics of sections `range` and, when `keep_leans`, their points' leans (section 0, on
+/// the bed, leans 0 and bounds no layer).
 ///
 /// Each point's lean is kept in single precision from [`atan_nonnegative`]; the largest lean is
 /// [`lean_deg`] exactly, evaluated only at points whose `tan` of the lean comes within 10⁻⁹ of
 /// the largest so far (or past 1000, 89.94°, where the arctangent flattens): a point further
 /// below cannot lean more, whatever the rounding of either arctangent.
-fn measure_part(sections: &[Section], range: std::ops::Range<usize>) -> (SurfaceMetrics, Vec<f32>) {
+fn measure_part(
+    sections: &[Section],
+    range: std::ops::Range<usize>,
+    keep_leans: bool,
+) -> (SurfaceMetrics, Vec<f32>) {
     let mut m = SurfaceMetrics {
         min_layer_height: f64::INFINITY,
         ..Default::default()
     };
-    let mut leans =
-        Vec::with_capacity(sections[range.clone()].iter().map(|s| s.points.len()).sum());
+    let mut leans = Vec::with_capacity(if keep_leans {
+        sections[range.clone()].iter().map(|s| s.points.len()).sum()
+    } else {
+        0
+    });
     // The largest tan of a lean measured exactly so far.
     let mut steepest = 0.0_f64;
     for k in range {
         let s = &sections[k];
         if k == 0 {
-            leans.resize(s.points.len(), 0.0);
+            if keep_leans {
+                leans.resize(s.points.len(), 0.0);
+            }
             continue;
         }
         let (lo, hi) = s.z_range();
@@ -348,7 +369,9 @@ fn measure_part(sections: &[Section], range: std::ops::Range<usize>) -> (Surface
                 m.max_overhang_deg = m.max_overhang_deg.max(lean_deg(*p, q, normals[i]));
                 steepest = steepest.max(tan);
             }
-            leans.push(atan_nonnegative(tan).to_degrees() as f32);
+            if keep_leans {
+                leans.push(atan_nonnegative(tan).to_degrees() as f32);
+            }
         }
     }
     (m, leans)
@@ -456,7 +479,7 @@ mod tests {
 
         /// The largest lean is the exact one of the point-by-point scan, to the bit, and every
         /// kept lean is that point's within single precision, on walls from plumb to
-        /// near-horizontal, with repeated heights.
+        /// near-horizontal, with repeated heights; measured without the leans, the same metrics.
         #[test]
         fn the_largest_lean_is_the_exact_scans(
             radii in proptest::collection::vec(proptest::collection::vec(10.0..40.0f64, 8), 2..12),
@@ -491,6 +514,8 @@ mod tests {
                 }
             }
             proptest::prop_assert_eq!(m.max_overhang_deg.to_bits(), exact.to_bits());
+            // Without the leans kept (the command line's surface), the same metrics.
+            proptest::prop_assert_eq!(measure(&sections), m);
         }
     }
 

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use glam::DVec2;
 
-use crate::constraint::{SurfaceMetrics, clamp_overhang, measure_with_leans};
+use crate::constraint::{SurfaceMetrics, clamp_overhang, measure, measure_with_leans};
 use crate::design::Design;
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind, group_events};
@@ -29,7 +29,8 @@ pub struct Surface {
     pub findings: Vec<Finding>,
     pub metrics: SurfaceMetrics,
     /// Lean from vertical of every point, section-major (`k·n + i`), degrees (the view colours
-    /// the wall by it).
+    /// the wall by it): empty for a surface made without a view (the command line's; the
+    /// view's mesh then measures them itself).
     pub point_leans_deg: Vec<f32>,
 }
 
@@ -97,7 +98,7 @@ pub fn finish_surface(
         layers: model.layers,
         layer_pitch: model.layer_pitch,
     };
-    finish_sections(design, grid, sections, findings, displacements)
+    finish_sections(design, grid, sections, findings, displacements, true)
 }
 
 /// Where the sections of a surface stand: the vessel's centre on the bed, the layer count and
@@ -109,13 +110,15 @@ pub struct SectionGrid {
     pub layer_pitch: f64,
 }
 
-/// [`finish_surface`] for sections from anywhere (a lofted design's or a mesh's slices).
+/// [`finish_surface`] for sections from anywhere (a lofted design's or a mesh's slices), keeping
+/// each point's lean ([`Surface::point_leans_deg`]) only when `keep_leans` (for a view).
 pub fn finish_sections(
     design: &Design,
     grid: SectionGrid,
     mut sections: Vec<Section>,
     mut findings: Vec<Finding>,
     displacements: Option<&[Vec<f64>]>,
+    keep_leans: bool,
 ) -> Result<Surface, FieldError> {
     let center = grid.center;
     findings.extend(correct_shape(design, &mut sections, 1));
@@ -160,7 +163,11 @@ pub fn finish_sections(
             |mm| format!("textured wall clamped by up to {mm:.2} mm at the overhang limit"),
         ));
     }
-    let (metrics, point_leans_deg) = measure_with_leans(&sections);
+    let (metrics, point_leans_deg) = if keep_leans {
+        measure_with_leans(&sections)
+    } else {
+        (measure(&sections), Vec::new())
+    };
     let surface = Surface {
         sections,
         layers: grid.layers,
@@ -266,7 +273,7 @@ fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldErr
 /// Runs the whole pipeline (a fresh [`Session`]'s first update): the design validated, the
 /// surface, then the single spiral toolpath.
 pub fn run(design: &Design) -> Result<PrintJob, FieldError> {
-    let mut session = Session::new();
+    let mut session = Session::for_one_update();
     session.update(design)?;
     Ok(session.job().expect("a successful update has a job"))
 }
