@@ -353,14 +353,11 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
             println!("{w}");
         }
         // Stretches of bead with nothing under them (at most a few lines: the worst first).
-        if let Ok(mut droops) = clayloft_core::printability::droops(d, &job.surface) {
-            droops.sort_by(|a, b| (b.length - b.limit).total_cmp(&(a.length - a.limit)));
-            for x in droops.iter().take(3) {
-                println!("{}", x.summary(p.body.name));
-            }
-            if droops.len() > 3 {
-                println!("droop: {} more layers", droops.len() - 3);
-            }
+        for x in p.droops.iter().take(3) {
+            println!("{}", x.summary(p.body.name));
+        }
+        if p.droops.len() > 3 {
+            println!("droop: {} more layers", p.droops.len() - 3);
         }
     }
     let findings: Vec<_> = job.findings().collect();

@@ -61,7 +61,7 @@ fn pipeline(c: &mut Criterion) {
         ..Default::default()
     });
     assert!(
-        clayloft_core::printability::assess(&soft, &job.toolpath)
+        clayloft_core::printability::assess(&soft, &job.surface, &job.toolpath)
             .unwrap()
             .min_layer_time_to_stand
             .is_some()
@@ -69,10 +69,18 @@ fn pipeline(c: &mut Criterion) {
     let mut g = c.benchmark_group("printability");
     g.sample_size(10);
     g.bench_function("assess_720x300", |b| {
-        b.iter(|| black_box(clayloft_core::printability::assess(&design, &job.toolpath).unwrap()))
+        b.iter(|| {
+            black_box(
+                clayloft_core::printability::assess(&design, &job.surface, &job.toolpath).unwrap(),
+            )
+        })
     });
     g.bench_function("assess_720x300_with_min_layer_time", |b| {
-        b.iter(|| black_box(clayloft_core::printability::assess(&soft, &job.toolpath).unwrap()))
+        b.iter(|| {
+            black_box(
+                clayloft_core::printability::assess(&soft, &job.surface, &job.toolpath).unwrap(),
+            )
+        })
     });
     g.bench_function("droops_720x300", |b| {
         b.iter(|| black_box(clayloft_core::printability::droops(&design, &job.surface).unwrap()))

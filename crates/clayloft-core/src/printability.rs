@@ -25,8 +25,11 @@
 //! flares carries a little more per bead); the base, a solid disc, does not buckle; the
 //! youngest point of each layer (its end) stands for the layer.
 
+use glam::DVec2;
+
 use crate::clay::{ClayBody, GRAVITY};
 use crate::design::Design;
+use crate::pipeline::Surface;
 use crate::toolpath::Toolpath;
 use crate::validate::FieldError;
 
@@ -83,6 +86,9 @@ pub struct Printability {
     /// Each judged layer's top, mm, and its own lowest safety factor over the print, bottom up
     /// (for colouring the wall).
     pub layer_factors: Vec<(f64, f64)>,
+    /// The layers with a stretch of bead that has nothing under it ([`droops`]), the one most
+    /// past its limit first.
+    pub droops: Vec<Droop>,
 }
 
 impl Printability {
@@ -114,13 +120,33 @@ struct Layer {
 }
 
 /// Judges the print of `toolpath` in the design's clay body.
-pub fn assess(design: &Design, toolpath: &Toolpath) -> Result<Printability, FieldError> {
+///
+/// With it, the layers of `surface` (the toolpath's wall) that droop, found on a second core
+/// meanwhile.
+pub fn assess(
+    design: &Design,
+    surface: &Surface,
+    toolpath: &Toolpath,
+) -> Result<Printability, FieldError> {
     let body = crate::clay::resolve(design.clay.as_ref())?;
+    let (droops, verdict) = crate::parallel::both(
+        toolpath.points.len() >= 20_000,
+        || droops(design, surface),
+        || standing(design, &body, toolpath),
+    );
+    let mut droops = droops?;
+    droops.sort_by(|a, b| (b.length - b.limit).total_cmp(&(a.length - a.limit)));
+    Ok(Printability { droops, ..verdict })
+}
+
+/// The safety factor of the wet wall of `toolpath` in clay `body` (see the module
+/// documentation), and the layer time that would make it stand.
+fn standing(design: &Design, body: &ClayBody, toolpath: &Toolpath) -> Printability {
     let layers = layers_of(design, toolpath);
     let thickness = design.shape.walls.max(1) as f64 * design.printer.line_width * 1e-3;
-    let mut verdict = weakest(&body, &layers, thickness, 0.0);
+    let mut verdict = weakest(body, &layers, thickness, 0.0);
     verdict.min_layer_time_to_stand = if verdict.factor >= 1.0
-        || weakest(&body, &layers, thickness, MAX_LAYER_TIME).factor < 1.0
+        || weakest(body, &layers, thickness, MAX_LAYER_TIME).factor < 1.0
     {
         // It stands already, or no layer time up to an hour saves it.
         None
@@ -129,7 +155,7 @@ pub fn assess(design: &Design, toolpath: &Toolpath) -> Result<Printability, Fiel
         let (mut lo, mut hi) = (0.0, MAX_LAYER_TIME);
         for _ in 0..40 {
             let mid = 0.5 * (lo + hi);
-            if weakest(&body, &layers, thickness, mid).factor >= 1.0 {
+            if weakest(body, &layers, thickness, mid).factor >= 1.0 {
                 hi = mid;
             } else {
                 lo = mid;
@@ -137,7 +163,7 @@ pub fn assess(design: &Design, toolpath: &Toolpath) -> Result<Printability, Fiel
         }
         Some(hi)
     };
-    Ok(verdict)
+    verdict
 }
 
 /// The toolpath's layers (base layers and wall revolutions), grouped to at most [`MAX_LAYERS`].
@@ -228,6 +254,7 @@ fn weakest(body: &ClayBody, layers: &[Layer], e: f64, min_layer_time: f64) -> Pr
             .iter()
             .map(|l| (l.top * 1e3, f64::INFINITY))
             .collect(),
+        droops: Vec::new(),
     };
     // Both factors are τ₀(age)/(ρ·g·h) times a constant of the loaded layer: √3 for plastic
     // collapse, γ·E₀·e/(1.5·R·τ₀) for buckling (γ the layer's knock-down factor, E(age) =
@@ -360,13 +387,24 @@ pub fn droops(
         }
         // A point is supported when some chord of the layer below comes within half a bead;
         // searched near the same column (a texture moves a point along the normal, never far
-        // round the vessel), the same column first: almost every point is supported there.
+        // round the vessel): the chords from below[j] to below[j + 1] for j from i − reach to
+        // i + reach − 1, the nearest first (almost every point is supported there).
         let window = (n / 16).clamp(4, 64);
+        let chord_within = |i: usize, o: isize| {
+            let mut j = i as isize + o;
+            while j < 0 {
+                j += n as isize;
+            }
+            let j = if (j as usize) < n {
+                j as usize
+            } else {
+                j as usize % n
+            };
+            let k = if j + 1 == n { 0 } else { j + 1 };
+            within(here[i], below[j], below[k], half)
+        };
         let supported_within = |i: usize, reach: usize| {
-            (0..2 * reach).map(|o| (i + n - reach + o) % n).any(|j| {
-                crate::geometry::point_segment_distance(here[i], below[j], below[(j + 1) % n]).0
-                    <= half
-            })
+            (0..reach as isize).any(|m| chord_within(i, m) || chord_within(i, -m - 1))
         };
         let free: Vec<bool> = (0..n)
             .map(|i| !supported_within(i, 2) && !supported_within(i, window))
@@ -403,6 +441,34 @@ pub fn droops(
     Ok(out)
 }
 
+/// Whether point `p` is within `r` of the segment from `a` to `b`: exactly
+/// `point_segment_distance(p, a, b).0 <= r`, decided on squared lengths without a division or
+/// square root unless the point is within a relative 10⁻⁹ of the edge (the squares' rounding
+/// is far smaller), where the exact distance decides.
+fn within(p: DVec2, a: DVec2, b: DVec2, r: f64) -> bool {
+    const SLACK: f64 = 1e-9;
+    let (ab, ap) = (b - a, p - a);
+    let (len2, dot) = (ab.length_squared(), ap.dot(ab));
+    let r2 = r * r;
+    // d², and the r² it is compared with scaled alike: beside an end, |p − end|² against r²;
+    // beside the inside of the segment, cross(ab, ap)² = d²·|ab|² against r²·|ab|².
+    let (d2, limit) = if dot <= 0.0 || len2 <= 0.0 {
+        (ap.length_squared(), r2)
+    } else if dot >= len2 {
+        ((p - b).length_squared(), r2)
+    } else {
+        let cross = ab.perp_dot(ap);
+        (cross * cross, r2 * len2)
+    };
+    if d2 < limit * (1.0 - SLACK) {
+        true
+    } else if d2 > limit * (1.0 + SLACK) {
+        false
+    } else {
+        crate::geometry::point_segment_distance(p, a, b).0 <= r
+    }
+}
+
 impl Droop {
     /// One line for the summary.
     pub fn summary(&self, body: &str) -> String {
@@ -417,6 +483,12 @@ impl Droop {
 mod tests {
     use super::*;
     use crate::load::parse_design;
+
+    /// The verdict on a design's job, judged as the design says (not at its wet size).
+    fn judged(d: &Design) -> Printability {
+        let job = crate::run(d).unwrap();
+        assess(d, &job.surface, &job.toolpath).unwrap()
+    }
 
     fn cylinder(height: f64, radius: f64, extra: &str) -> Design {
         parse_design(&format!(
@@ -434,7 +506,7 @@ mod tests {
             "[clay]\nstructuration_rate = 0.0\nelastic_modulus = 1e8\nwet_density = 1900.0\nyield_stress = 2000.0\n",
         );
         let job = crate::run(&d).unwrap();
-        let p = assess(&d, &job.toolpath).unwrap();
+        let p = assess(&d, &job.surface, &job.toolpath).unwrap();
         let expected = 3f64.sqrt() * 2000.0 / (1900.0 * GRAVITY * 0.100);
         assert!(
             (p.factor - expected).abs() / expected < 1e-6,
@@ -462,7 +534,7 @@ mod tests {
             "[clay]\nyield_stress = 2500.0\nstructuration_rate = 0.05\nelastic_modulus = 1e8\n",
         );
         let job = crate::run(&d).unwrap();
-        let p = assess(&d, &job.toolpath).unwrap();
+        let p = assess(&d, &job.surface, &job.toolpath).unwrap();
         assert!(p.factor < 1.0, "{}", p.factor);
         assert_eq!(p.mechanism, Mechanism::PlasticCollapse);
         let t = p.min_layer_time_to_stand.expect("a layer time saves it");
@@ -474,10 +546,10 @@ mod tests {
         // With that minimum layer time it stands, and just under it it does not.
         let mut slow = d.clone();
         slow.printer.min_layer_time = t.ceil();
-        let p2 = assess(&slow, &crate::run(&slow).unwrap().toolpath).unwrap();
+        let p2 = judged(&slow);
         assert!(p2.factor >= 1.0, "{}", p2.factor);
         slow.printer.min_layer_time = (t * 0.9).floor();
-        let p3 = assess(&slow, &crate::run(&slow).unwrap().toolpath).unwrap();
+        let p3 = judged(&slow);
         assert!(p3.factor < 1.0, "{}", p3.factor);
     }
 
@@ -486,7 +558,7 @@ mod tests {
         let clay =
             "[clay]\nyield_stress = 3000.0\nelastic_modulus = 60000.0\nstructuration_rate = 0.0\n";
         let d = cylinder(150.0, 90.0, clay);
-        let p = assess(&d, &crate::run(&d).unwrap().toolpath).unwrap();
+        let p = judged(&d);
         assert_eq!(p.mechanism, Mechanism::Buckling);
         // F = γ E e / (1.5 R ρ g h) with R = 90 mm, e = 3 mm at the wall's foot.
         let (r, e, h) = (0.090, 0.003, 0.150 - 0.001);
@@ -499,7 +571,7 @@ mod tests {
         );
         let mut two = d.clone();
         two.shape.walls = 2;
-        let p2 = assess(&two, &crate::run(&two).unwrap().toolpath).unwrap();
+        let p2 = judged(&two);
         // Twice the thickness, a shorter inner bead (smaller mean radius): more than twice.
         assert!(p2.factor > 2.0 * p.factor, "{} {}", p2.factor, p.factor);
     }
@@ -526,7 +598,15 @@ mod tests {
             ))
             .unwrap();
             let job = crate::run(&d).unwrap();
-            droops(&d, &job.surface).unwrap()
+            let found = droops(&d, &job.surface).unwrap();
+            // The verdict names the same layers, the one most past its limit first.
+            let listed = assess(&d, &job.surface, &job.toolpath).unwrap().droops;
+            let excess = |x: &Droop| x.length - x.limit;
+            assert!(listed.windows(2).all(|w| excess(&w[0]) >= excess(&w[1])));
+            let mut by_layer = listed.clone();
+            by_layer.sort_by_key(|x| x.layer);
+            assert_eq!(by_layer, found);
+            found
         };
         let found = steep(false);
         assert!(!found.is_empty());
@@ -541,6 +621,32 @@ mod tests {
                 .unwrap()
                 .is_empty()
         );
+    }
+
+    proptest::proptest! {
+        /// The squared test of a point near a segment is the exact distance's, on points far,
+        /// near and exactly at the edge (at each end, beside the inside, on a segment of no
+        /// length).
+        #[test]
+        fn within_is_the_exact_distance_test(
+            a in proptest::array::uniform2(-50.0..50.0f64),
+            b in proptest::array::uniform2(-50.0..50.0f64),
+            p in proptest::array::uniform2(-50.0..50.0f64),
+            r in 0.0..30.0f64,
+            f in -0.5..1.5f64,
+            zero in proptest::bool::ANY,
+        ) {
+            let (a, p) = (DVec2::from(a), DVec2::from(p));
+            let b = if zero { a } else { DVec2::from(b) };
+            let exact = |p: DVec2, r: f64| crate::geometry::point_segment_distance(p, a, b).0 <= r;
+            proptest::prop_assert_eq!(within(p, a, b, r), exact(p, r));
+            // At the edge: r is the distance itself, and the floats next to it.
+            let q = a + (b - a) * f + (p - a) * 0.1;
+            let d = crate::geometry::point_segment_distance(q, a, b).0;
+            for r in [d, d.next_up(), d.next_down()] {
+                proptest::prop_assert_eq!(within(q, a, b, r), exact(q, r), "{} {}", d, r);
+            }
+        }
     }
 
     #[test]
@@ -560,7 +666,7 @@ mod tests {
         let job = crate::run(&d).unwrap();
         assert!(job.toolpath.layer_starts.len() > 2900);
         let start = std::time::Instant::now();
-        let p = assess(&d, &job.toolpath).unwrap();
+        let p = assess(&d, &job.surface, &job.toolpath).unwrap();
         assert!(p.factor.is_finite());
         assert!(start.elapsed().as_secs() < 20);
     }

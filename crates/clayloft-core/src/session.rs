@@ -233,8 +233,8 @@ struct LaterStages {
     view: Stage<WallViewKey, Arc<WallBuffers>>,
 }
 
-/// Inputs of the printability verdict: the toolpath (by revision), the clay body and the wall's
-/// thickness.
+/// Inputs of the printability verdict: the toolpath (by revision; a new surface, whose droops
+/// the verdict lists, makes a new toolpath), the clay body and the wall's thickness.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VerdictKey {
     pub toolpath: u64,
@@ -821,7 +821,7 @@ fn finish_stages(
         line_width: p.line_width,
     };
     done.verdict = later.verdict.refresh(verdict_key, || {
-        Ok(crate::printability::assess(design, toolpath)
+        Ok(crate::printability::assess(design, &surface, toolpath)
             .ok()
             .map(Arc::new))
     })?;
@@ -984,7 +984,9 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
                 let wet = crate::clay::wet_design(d).unwrap();
                 assert_eq!(
                     session.printability().map(|p| &**p),
-                    crate::printability::assess(&wet, &b.toolpath).ok().as_ref(),
+                    crate::printability::assess(&wet, &b.surface, &b.toolpath)
+                        .ok()
+                        .as_ref(),
                     "verdict differs from a batch run"
                 );
                 let mesh = crate::view_mesh::wall_buffers(

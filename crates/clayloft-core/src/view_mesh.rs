@@ -223,7 +223,7 @@ mod tests {
         )
         .unwrap();
         let job = crate::run(&d).unwrap();
-        let p = crate::printability::assess(&d, &job.toolpath).unwrap();
+        let p = crate::printability::assess(&d, &job.surface, &job.toolpath).unwrap();
         assert!(p.factor < 1.0);
         let mut b = wall_buffers(&job.surface, None, 45.0);
         b.colour_by_safety(&p);

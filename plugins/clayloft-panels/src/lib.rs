@@ -472,6 +472,16 @@ fn printability_panel(
             ));
         }
     }
+    // Stretches of bead with nothing under them, the worst first (what `clayloft gcode` prints).
+    for d in p.droops.iter().take(3) {
+        ui.colored_label(
+            egui::Color32::from_rgb(240, 200, 90),
+            d.summary(p.body.name),
+        );
+    }
+    if p.droops.len() > 3 {
+        ui.label(format!("droop: {} more layers", p.droops.len() - 3));
+    }
 }
 
 #[cfg(test)]
@@ -498,23 +508,25 @@ mod tests {
     /// would help).
     #[test]
     fn the_printability_panel_says_whether_the_wall_stands_and_why() {
-        let verdict = |extra: &str, height: f64| {
+        let verdict = |printer: &str, extra: &str, height: f64| {
             let design = clayloft_core::load::parse_design(&format!(
-                "version = 1\n[printer]\nmax_z = 1000.0\n[shape]\nheight = {height}\nlower = {{ type = \"circle\", radius = 60.0 }}\nupper = {{ type = \"circle\", radius = 60.0 }}\n{extra}"
+                "version = 1\n[printer]\nmax_z = 1000.0\n{printer}[shape]\nheight = {height}\nlower = {{ type = \"circle\", radius = 60.0 }}\nupper = {{ type = \"circle\", radius = 60.0 }}\n{extra}"
             ))
             .unwrap();
             let job = clayloft_core::run(&design).unwrap();
-            let p = clayloft_core::printability::assess(&design, &job.toolpath).unwrap();
+            let p =
+                clayloft_core::printability::assess(&design, &job.surface, &job.toolpath).unwrap();
             let mut h = Harness::builder()
                 .with_size(egui::vec2(320.0, 600.0))
                 .build_ui(move |ui| printability_panel(ui, &p, &design, &ModelStatus::default()));
             h.run();
             h
         };
-        let h = verdict("", 60.0);
+        let h = verdict("", "", 60.0);
         assert!(h.query_by_label_contains("is laid").is_some());
         assert!(h.query_by_label_contains("It stands.").is_some());
         let h = verdict(
+            "",
             "[clay]\nbody = \"porcelain\"\nstructuration_rate = 0.05\n",
             400.0,
         );
@@ -523,6 +535,16 @@ mod tests {
                 .is_some()
         );
         assert!(h.query_by_label_contains("min_layer_time").is_some());
+        assert!(h.query_by_label_contains("droop").is_none());
+        // A deep, steep texture printed without enforcement on a printer that allows 70°:
+        // stretches of bead with nothing under them, named under the verdict.
+        let h = verdict(
+            "max_overhang_deg = 70.0\n",
+            "[texture]\ncombine = \"sum\"\nphase_drift = 40.0\n[texture.x]\nwave = \"square\"\nperiod = 90\namplitude = 4.0\n[constraints]\nenforce = false\n",
+            30.0,
+        );
+        let named = h.query_all_by_label_contains("droop: layer").count();
+        assert!((1..=3).contains(&named), "{named} droops named");
     }
 
     #[test]
