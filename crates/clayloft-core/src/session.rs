@@ -320,7 +320,9 @@ impl Session {
     /// complete job, and [`Session::is_current`] is false until an update succeeds.
     pub fn update(&mut self, design: &Design) -> Result<Update, FieldError> {
         self.updates += 1;
-        // The vessel is built at its wet size (SPEC §14: enlarged to fire to the designed size).
+        // The vessel is built at its wet size (SPEC §14: enlarged to fire to the designed size);
+        // the session keeps the design as given (what the job is asked for by).
+        let given = design;
         let wet = crate::clay::wet_design(design);
         let design = match &wet {
             Ok(d) => d.as_ref(),
@@ -339,10 +341,10 @@ impl Session {
                     toolpath: self.later.toolpath.get().expect("updated").clone(),
                     verdict: self.later.verdict.get().expect("updated").clone(),
                 });
-                if self.design.as_ref() != Some(design)
-                    || self.design.as_ref().map(|d| &d.base_dir) != Some(&design.base_dir)
+                if self.design.as_ref() != Some(given)
+                    || self.design.as_ref().map(|d| &d.base_dir) != Some(&given.base_dir)
                 {
-                    self.design = Some(design.clone());
+                    self.design = Some(given.clone());
                 }
             }
             Err(e) => self.error = Some(e.clone()),
@@ -517,7 +519,9 @@ impl Session {
         self.job.clone()
     }
 
-    /// The design the current job was computed from.
+    /// The design the current job was computed from, as given to [`Session::update`] (a
+    /// design printed enlarged to fire to its size is computed at its wet size, but this is
+    /// the design as drawn).
     pub fn design(&self) -> Option<&Design> {
         self.design.as_ref()
     }
@@ -1029,6 +1033,26 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
                 assert_same_as_batch(&session, &d, &r);
             }
         }
+    }
+
+    /// A design printed enlarged to fire to its size: the job is of the wet design, and the
+    /// session says it is the design as given (what the app asks the job for by).
+    #[test]
+    fn the_session_keeps_the_design_as_given() {
+        let mut d = design();
+        d.clay = Some(crate::clay::ClayTable {
+            compensate_shrinkage: true,
+            ..Default::default()
+        });
+        let wet = crate::clay::wet_design(&d).unwrap().into_owned();
+        assert_ne!(wet, d);
+        let mut s = Session::new();
+        s.update(&d).unwrap();
+        assert_eq!(s.design(), Some(&d));
+        assert_eq!(
+            *s.job().unwrap().toolpath,
+            *crate::run(&d).unwrap().toolpath
+        );
     }
 
     #[test]

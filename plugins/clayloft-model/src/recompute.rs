@@ -240,3 +240,31 @@ pub fn derive_control_lines(
         commands.spawn((line, ControlLineCurve(curve(line))));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The job is the document's whatever the session builds it at: a design that is printed
+    /// enlarged to fire to its size (the session works on the enlarged, wet design) is exported
+    /// and printed from its own job, and an edit makes it not current until it is recomputed.
+    #[test]
+    fn the_current_job_is_the_documents_even_when_printed_enlarged() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../assets/designs/porcelain-beaker.toml");
+        let design = clayloft_core::load_design(&path).unwrap().design;
+        assert!(design.clay.as_ref().is_some_and(|c| c.compensate_shrinkage));
+        let mut engine = Engine::default();
+        engine.0.update(&design).unwrap();
+        let job = engine
+            .current_job(&design)
+            .expect("the job of the design just computed");
+        assert_eq!(
+            job.toolpath.points,
+            clayloft_core::run(&design).unwrap().toolpath.points
+        );
+        let mut edited = design.clone();
+        edited.shape.height += 5.0;
+        assert!(engine.current_job(&edited).is_err());
+    }
+}
