@@ -3,6 +3,7 @@
 //! and a status line. Panels edit the design document only; everything else follows from it.
 
 mod design_form;
+mod figures;
 mod reference;
 mod source_preview;
 mod widgets;
@@ -17,9 +18,6 @@ use clayloft_files::{FileCommand, FileStatus};
 use clayloft_model::*;
 use clayloft_replay::{Replay, ReplayPath};
 use clayloft_view::{FrameVessel, ViewSettings, WallStats};
-
-/// The toolpath the status line's figures are of (its address), its length and its print time.
-type PathFigures = (usize, f64, f64);
 
 /// How long a pick or drag hint stays in the status line.
 const HINT_LIFETIME: std::time::Duration = std::time::Duration::from_secs(12);
@@ -61,13 +59,17 @@ fn draw_panels(
     history: Res<clayloft_edit::History>,
     mut settings: ResMut<ViewSettings>,
     (mut replay, replay_path): (ResMut<Replay>, Res<ReplayPath>),
-    wall: Res<WallStats>,
+    (wall, engine, mut redraw): (
+        Res<WallStats>,
+        Res<Engine>,
+        MessageWriter<bevy::window::RequestRedraw>,
+    ),
     vessel: Query<&VesselSurface>,
     toolpath: Query<(&ToolpathPath, Option<&ToolpathPrintability>)>,
     selection: Res<Selection>,
     (mut panel, mut frame): (ResMut<PanelInUse>, MessageWriter<FrameVessel>),
-    (mut path_figures, hint, mut hint_since): (
-        Local<PathFigures>,
+    (mut job_figures, hint, mut hint_since): (
+        Local<figures::JobFigures>,
         Res<DragHint>,
         Local<Option<std::time::Instant>>,
     ),
@@ -176,17 +178,23 @@ fn draw_panels(
     egui::Panel::bottom("status line").show(&mut root, |ui| {
         ui.horizontal_wrapped(|ui| {
             if let (Some(s), Some((tp, _))) = (vessel.iter().next(), toolpath.iter().next()) {
-                // Length and time walk the whole path: once per toolpath, not once per frame.
+                // Length and planned time walk the whole path: once per toolpath, on a thread
+                // of their own.
                 let key = std::sync::Arc::as_ptr(&tp.0) as usize;
-                if path_figures.0 != key {
-                    *path_figures = (key, tp.0.length(), tp.0.print_time());
+                let (figures, busy) = job_figures.update(key, || {
+                    let design = doc.design.clone();
+                    engine.current_job(&design).ok().map(|job| (design, job))
+                });
+                if busy {
+                    redraw.write(bevy::window::RequestRedraw);
                 }
+                let (length, time) = figures.map_or(("…".into(), "…".into()), |(l, t)| {
+                    (format!("{:.1} m", l / 1000.0), format_duration(t))
+                });
                 ui.label(format!(
-                    "{} layers · {} points · path {:.1} m · print ≈ {} · max overhang {:.1}°",
+                    "{} layers · {} points · path {length} · print ≈ {time} · max overhang {:.1}°",
                     s.0.layers,
                     tp.0.points.len(),
-                    path_figures.1 / 1000.0,
-                    format_duration(path_figures.2),
                     s.0.metrics.max_overhang_deg,
                 ));
                 if wall.violating_points > 0 {
