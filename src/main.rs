@@ -12,10 +12,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use clayloft_core::check::{GcodeVerifier, Limits, check_gcode};
+use clayloft_core::check::{Limits, check_gcode};
 // The batch commands keep the helper threads spinning from start to end: their stages follow
 // each other closely (see `clayloft_core::parallel`).
-use clayloft_core::gcode::{JobSummary, format_duration, summarize, write_gcode_summarized};
+use clayloft_core::export::{ExportError, write_checked_gcode};
+use clayloft_core::gcode::{JobSummary, format_duration, summarize};
 use clayloft_core::parallel::awake;
 use clayloft_core::stl::{job_mesh, write_ascii_stl, write_binary_stl};
 use clayloft_core::{LoadedDesign, PrintJob, load_design};
@@ -373,76 +374,21 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
 
 fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
     let (loaded, job) = job_of(design, printer)?;
-    let d = &loaded.design;
-    // Right first time: the program is re-measured by the checker on its way to the disk (read
-    // as it is written, so the text is never kept whole); the file is put in place only if it
-    // passes, and a design that still breaks a limit on this printer is refused with what broke.
-    let mut verifier = d
-        .constraints
-        .enforce
-        .then(|| GcodeVerifier::with_capacity(job.toolpath.points.len() + 64));
-    let (pending, summary) = clayloft_core::atomic::prepare(out, |file| {
-        let mut sink = Tee {
-            file,
-            verifier: verifier.as_mut(),
-        };
-        write_gcode_summarized(d, &job, &mut sink)
+    // Right first time: the program is re-measured by the checker on its way to the disk, and
+    // a design that still breaks a limit on this printer is refused with what broke.
+    let written = write_checked_gcode(&loaded.design, &job, out).map_err(|e| match e {
+        ExportError::Refused { .. } => Failure(format!("{}: {e}", loaded.path.display())),
+        other => Failure(other.to_string()),
     })?;
-    if let Some(verifier) = verifier {
-        let report = verifier.finish(&Limits::from(&d.printer)).map_err(|e| {
-            Failure(format!(
-                "{}: the G-code written does not read back: {e}",
-                out.display()
-            ))
-        })?;
-        if let Some(v) = report.as_ref().and_then(|r| r.violations.first()) {
-            // Dropped, the pending file is deleted: nothing is written.
-            drop(pending);
-            return Err(Failure(format!(
-                "{}: does not print on this printer ({}): {} at {} points, worst {:.2} ({}); try a printer with a finer bead or thinner layers, or a simpler contour",
-                loaded.path.display(),
-                d.printer
-                    .profile
-                    .as_deref()
-                    .unwrap_or("the paper's printer"),
-                v.what,
-                v.count,
-                v.worst,
-                v.detail
-            )));
-        }
-    }
-    let replaced = pending.commit()?;
     // The file replaced is freed on the second core while this one prints.
+    let replaced = written.replaced;
     clayloft_core::parallel::both(
         true,
         move || drop(replaced),
-        || print_summary(&loaded, &job, Some(summary)),
+        || print_summary(&loaded, &job, Some(written.summary)),
     );
     println!("wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
-}
-
-/// Writes to the output file and, when there is one, to the self-check: the file first (0.15 ms
-/// a piece of 600 kB here), then the self-check, which reads a large piece on both cores (1.3 ms
-/// on one).
-struct Tee<'a> {
-    file: &'a mut dyn std::io::Write,
-    verifier: Option<&'a mut GcodeVerifier>,
-}
-
-impl std::io::Write for Tee<'_> {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.file.write_all(buf)?;
-        if let Some(v) = self.verifier.as_deref_mut() {
-            v.write_all(buf)?;
-        }
-        Ok(buf.len())
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.file.flush()
-    }
 }
 
 fn stl(design: &Path, out: &Path, ascii: bool, printer: Option<&str>) -> Result<ExitCode, Failure> {

@@ -29,6 +29,7 @@ pub mod contour;
 pub mod control;
 pub mod decimal;
 pub mod design;
+pub mod export;
 pub mod fields;
 pub mod gcode;
 pub mod geometry;

@@ -81,7 +81,8 @@ impl Plugin for PrinterPlugin {
 }
 
 /// Starts printing `job` (the session's, for `design`) on `port`: the core writes the program
-/// with each line's path point, and a background thread streams it.
+/// with each line's path point, checks it as `clayloft gcode` does (a program past the
+/// printer's limits is refused), and a background thread streams it.
 pub fn start_job(
     design: &clayloft_core::Design,
     job: &clayloft_core::PrintJob,
@@ -89,6 +90,9 @@ pub fn start_job(
     baud: u32,
 ) -> Result<Job, String> {
     let program = clayloft_core::gcode::program(design, job).map_err(|e| e.to_string())?;
+    // Right first time: a program that breaks a limit of this printer is not started.
+    clayloft_core::export::verify_program(design, &program.text)
+        .map_err(|e| format!("not printed: the design {e}"))?;
     let (cmds, point_of_command): (Vec<String>, Vec<usize>) = program
         .text
         .lines()
@@ -341,6 +345,27 @@ mod tests {
             )
         });
         (name, fake)
+    }
+
+    /// Right first time: the flared bowl's program leans past the WASP's limit at one point
+    /// (`clayloft gcode` refuses it), so printing it does not start, nor open the port.
+    #[test]
+    fn a_program_past_the_printers_limits_is_not_started() {
+        let bowl = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../assets/designs/flared-bowl.toml");
+        let design = clayloft_core::load::load_design_using(&bowl, Some("wasp-2040-clay"))
+            .unwrap()
+            .design;
+        let job = clayloft_core::run(&design).unwrap();
+        let e = start_job(&design, &job, "/nonexistent/port", 115_200)
+            .err()
+            .expect("refused");
+        assert!(
+            e.starts_with(
+                "not printed: the design does not print on this printer (wasp-2040-clay)"
+            ),
+            "{e}"
+        );
     }
 
     #[test]

@@ -1,0 +1,205 @@
+//! A job's G-code written to a file, right first time: what `clayloft gcode` and the app's
+//! "Export G-code" both do. With `constraints.enforce`, every piece the writer gives goes to a
+//! temporary file beside the output and to the self-check ([`crate::check::GcodeVerifier`],
+//! which reads it into moves as it comes, so the text is never held whole), and the file is
+//! renamed into place only when the check passes: a design that still breaks a limit on its
+//! printer is refused with what broke, and no file (nor temporary) is left.
+
+use std::io::Write;
+use std::path::Path;
+
+use crate::atomic::{Replaced, WriteError};
+use crate::check::{CheckReport, GcodeError, GcodeVerifier, Limits};
+use crate::design::Design;
+use crate::gcode::{JobSummary, write_gcode_summarized};
+use crate::pipeline::PrintJob;
+
+/// A G-code file in place: the header's figures, and the file it replaced (see [`Replaced`]:
+/// dropping it frees the old file's data, which a caller may do where it costs nothing).
+pub struct Written {
+    pub summary: JobSummary,
+    pub replaced: Replaced,
+}
+
+/// Why a job's G-code was not written.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The file could not be written (the message names it).
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    /// The program written does not read back as G-code (a writer's fault, never a design's).
+    #[error("{file}: the G-code written does not read back: {error}")]
+    Unreadable { file: String, error: GcodeError },
+    /// The program breaks a limit of its printer: the worst-reported violation.
+    #[error(
+        "does not print on this printer ({printer}): {what} at {count} points, worst {worst:.2} ({detail}); try a printer with a finer bead or thinner layers, or a simpler contour"
+    )]
+    Refused {
+        printer: String,
+        what: &'static str,
+        count: usize,
+        worst: f64,
+        detail: String,
+    },
+}
+
+/// Writes the G-code of `job` (of `design`) to `path`, re-measured on its way when the design
+/// enforces its constraints (see the module documentation).
+pub fn write_checked_gcode(
+    design: &Design,
+    job: &PrintJob,
+    path: &Path,
+) -> Result<Written, ExportError> {
+    let mut verifier = design
+        .constraints
+        .enforce
+        .then(|| GcodeVerifier::with_capacity(job.toolpath.points.len() + 64));
+    let (pending, summary) = crate::atomic::prepare(path, |file| {
+        let mut sink = Tee {
+            file,
+            verifier: verifier.as_mut(),
+        };
+        write_gcode_summarized(design, job, &mut sink)
+    })?;
+    if let Some(verifier) = verifier {
+        let report = verifier
+            .finish(&Limits::from(&design.printer))
+            .map_err(|error| ExportError::Unreadable {
+                file: path.display().to_string(),
+                error,
+            })?;
+        if let Some(refusal) = refusal(design, report.as_ref()) {
+            // Dropped, the pending file is deleted: nothing is written.
+            drop(pending);
+            return Err(refusal);
+        }
+    }
+    let replaced = pending.commit()?;
+    Ok(Written { summary, replaced })
+}
+
+/// Whether a program in memory (`text`, what a printer host streams) may go to the printer of
+/// `design`: the self-check of [`write_checked_gcode`] when the design enforces its
+/// constraints, with the same refusal.
+pub fn verify_program(design: &Design, text: &str) -> Result<(), ExportError> {
+    if !design.constraints.enforce {
+        return Ok(());
+    }
+    let report =
+        crate::check::verify_gcode(text, &Limits::from(&design.printer)).map_err(|error| {
+            ExportError::Unreadable {
+                file: "the program".into(),
+                error,
+            }
+        })?;
+    refusal(design, report.as_ref()).map_or(Ok(()), Err)
+}
+
+/// The refusal of a program whose self-check found `report` (none when it holds).
+fn refusal(design: &Design, report: Option<&CheckReport>) -> Option<ExportError> {
+    let v = report?.violations.first()?;
+    Some(ExportError::Refused {
+        printer: design
+            .printer
+            .profile
+            .clone()
+            .unwrap_or_else(|| "the paper's printer".into()),
+        what: v.what,
+        count: v.count,
+        worst: v.worst,
+        detail: v.detail.clone(),
+    })
+}
+
+/// Writes to the output file and, when there is one, to the self-check: the file first (0.15 ms
+/// a piece of 600 kB here), then the self-check, which reads a large piece on both cores (1.3 ms
+/// on one).
+struct Tee<'a> {
+    file: &'a mut dyn Write,
+    verifier: Option<&'a mut GcodeVerifier>,
+}
+
+impl Write for Tee<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.file.write_all(buf)?;
+        if let Some(v) = self.verifier.as_deref_mut() {
+            v.write_all(buf)?;
+        }
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vessel(extra: &str) -> (Design, PrintJob) {
+        let d = crate::load::parse_design(&format!(
+            "version = 1\n[shape]\nheight = 20.0\nsamples = 120\nlower = {{ type = \"circle\", radius = 30.0 }}\nupper = {{ type = \"circle\", radius = 32.0 }}\n{extra}"
+        ))
+        .unwrap();
+        let job = crate::run(&d).unwrap();
+        (d, job)
+    }
+
+    /// A design that keeps its limits: the file is the writer's program, byte for byte, and
+    /// replaces what was there.
+    #[test]
+    fn a_design_that_keeps_its_limits_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("v.gcode");
+        std::fs::write(&out, "old").unwrap();
+        let (d, job) = vessel("");
+        let written = write_checked_gcode(&d, &job, &out).unwrap();
+        let mut want = Vec::new();
+        let summary = write_gcode_summarized(&d, &job, &mut want).unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), want);
+        assert_eq!(written.summary, summary);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// A program that breaks a limit of its printer (a bed narrower than the vessel's path,
+    /// found by the checker alone: the design is given a wide bed, its printer limits a narrow
+    /// one): refused with what broke, and the old file stays, with no temporary beside it.
+    /// Without enforcement the same program is written.
+    #[test]
+    fn a_program_past_its_printers_limits_is_refused_and_nothing_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("v.gcode");
+        std::fs::write(&out, "old").unwrap();
+        let (mut d, job) = vessel("");
+        // The job was made for the default bed; the printer now ends just short of the vessel's
+        // far side.
+        let far = job
+            .toolpath
+            .points
+            .iter()
+            .map(|q| q.pos.x)
+            .fold(0.0, f64::max);
+        d.printer.bed_x = far - 5.0;
+        let e = write_checked_gcode(&d, &job, &out).err().expect("refused");
+        assert!(
+            matches!(e, ExportError::Refused { count, .. } if count > 0),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with("does not print on this printer (the paper's printer): "),
+            "{e}"
+        );
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        // A printer host's program in memory: the same refusal.
+        let program = crate::gcode::program(&d, &job).unwrap();
+        let again = verify_program(&d, &program.text).err().expect("refused");
+        assert_eq!(again.to_string(), e.to_string());
+        d.constraints.enforce = false;
+        assert!(verify_program(&d, &program.text).is_ok());
+        assert!(write_checked_gcode(&d, &job, &out).is_ok());
+        assert_ne!(std::fs::read_to_string(&out).unwrap(), "old");
+    }
+}
