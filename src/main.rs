@@ -13,10 +13,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use clayloft_core::check::{Limits, check_gcode};
-// The batch commands keep the helper threads spinning from start to end: their stages follow
-// each other closely (see `clayloft_core::parallel`).
 use clayloft_core::export::{ExportError, write_checked_gcode};
 use clayloft_core::gcode::{JobSummary, format_duration, summarize};
+// The batch commands keep the helper threads spinning from start to end: their stages follow
+// each other closely (see `clayloft_core::parallel`).
 use clayloft_core::parallel::awake;
 use clayloft_core::stl::{job_mesh, write_ascii_stl, write_binary_stl};
 use clayloft_core::{LoadedDesign, PrintJob, load_design};
