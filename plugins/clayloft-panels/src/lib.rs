@@ -68,8 +68,8 @@ fn draw_panels(
     toolpath: Query<(&ToolpathPath, Option<&ToolpathPrintability>)>,
     selection: Res<Selection>,
     (mut panel, mut frame): (ResMut<PanelInUse>, MessageWriter<FrameVessel>),
-    (mut job_figures, hint, mut hint_since): (
-        Local<figures::JobFigures>,
+    (mut job_work, hint, mut hint_since): (
+        Local<figures::JobWork>,
         Res<DragHint>,
         Local<Option<std::time::Instant>>,
     ),
@@ -78,6 +78,25 @@ fn draw_panels(
         *hint_since = Some(std::time::Instant::now());
     }
     let ctx = contexts.ctx_mut()?.clone();
+    let Some(doc_now) = doc.as_deref() else {
+        return Ok(());
+    };
+    // The job's figures and the self-check of its program, each on a thread of its own once
+    // per toolpath; the check once the toolpath has settled (not while a handle is dragged).
+    let now = std::time::Instant::now();
+    let key = toolpath
+        .iter()
+        .next()
+        .map(|(tp, _)| std::sync::Arc::as_ptr(&tp.0) as usize);
+    let shown = key.map(|key| {
+        job_work.update(key, now, doc_now.design.constraints.enforce, || {
+            let design = doc_now.design.clone();
+            engine.current_job(&design).ok().map(|job| (design, job))
+        })
+    });
+    if shown.as_ref().is_some_and(|s| s.busy) {
+        redraw.write(bevy::window::RequestRedraw);
+    }
     let Some(mut doc) = doc else { return Ok(()) };
     if fields.filled_from.as_ref() != Some(&doc.path) {
         fields.filled_from = Some(doc.path.clone());
@@ -178,16 +197,7 @@ fn draw_panels(
     egui::Panel::bottom("status line").show(&mut root, |ui| {
         ui.horizontal_wrapped(|ui| {
             if let (Some(s), Some((tp, _))) = (vessel.iter().next(), toolpath.iter().next()) {
-                // Length and planned time walk the whole path: once per toolpath, on a thread
-                // of their own.
-                let key = std::sync::Arc::as_ptr(&tp.0) as usize;
-                let (figures, busy) = job_figures.update(key, || {
-                    let design = doc.design.clone();
-                    engine.current_job(&design).ok().map(|job| (design, job))
-                });
-                if busy {
-                    redraw.write(bevy::window::RequestRedraw);
-                }
+                let figures = shown.as_ref().and_then(|s| s.figures);
                 let (length, time) = figures.map_or(("…".into(), "…".into()), |(l, t)| {
                     (format!("{:.1} m", l / 1000.0), format_duration(t))
                 });
@@ -253,6 +263,9 @@ fn draw_panels(
                 ui.separator();
                 let (path, verdict) = toolpath.iter().next().unzip();
                 findings_panel(ui, vessel.iter().next(), path, &design, &status);
+                if design.constraints.enforce && !status.is_stale() {
+                    program_panel(ui, shown.as_ref().and_then(|s| s.check.as_ref()));
+                }
                 if let Some(p) = verdict.flatten() {
                     ui.separator();
                     printability_panel(ui, &p.0, &design, &status);
@@ -387,6 +400,28 @@ fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
                     ui.label(format!("point {}: {} ({:.1})", e.line, e.what, e.value));
                 }
             });
+    }
+}
+
+/// The self-check's verdict on the job's G-code (what "Export G-code" and "Print design" run):
+/// `None` while it is worked out.
+fn program_panel(ui: &mut egui::Ui, verdict: Option<&figures::ProgramVerdict>) {
+    match verdict {
+        Some(Ok(())) => {
+            ui.colored_label(
+                egui::Color32::from_rgb(150, 220, 150),
+                "its G-code passes the checker on this printer",
+            );
+        }
+        Some(Err(why)) => {
+            ui.colored_label(
+                egui::Color32::from_rgb(255, 90, 90),
+                format!("its G-code does not pass the checker: the design {why}. Export G-code and Print design refuse it."),
+            );
+        }
+        None => {
+            ui.label(egui::RichText::new("checking its G-code …").weak());
+        }
     }
 }
 
@@ -553,6 +588,37 @@ mod tests {
         );
         let named = h.query_all_by_label_contains("droop: layer").count();
         assert!((1..=3).contains(&named), "{named} droops named");
+    }
+
+    /// The program check's verdict in words: passing, refused (with why, and that the export
+    /// and the printer refuse it), and while it is worked out.
+    #[test]
+    fn the_program_panel_says_whether_the_g_code_passes() {
+        let shown = |verdict: Option<figures::ProgramVerdict>| {
+            let mut h = Harness::builder()
+                .with_size(egui::vec2(320.0, 300.0))
+                .build_ui(move |ui| program_panel(ui, verdict.as_ref()));
+            h.run();
+            h
+        };
+        assert!(
+            shown(Some(Ok(())))
+                .query_by_label_contains("passes the checker")
+                .is_some()
+        );
+        let refused = shown(Some(Err(
+            "does not print on this printer (x): overhang".into()
+        )));
+        assert!(
+            refused
+                .query_by_label_contains("does not pass the checker: the design does not print on this printer (x): overhang. Export G-code and Print design refuse it")
+                .is_some()
+        );
+        assert!(
+            shown(None)
+                .query_by_label_contains("checking its G-code")
+                .is_some()
+        );
     }
 
     #[test]
