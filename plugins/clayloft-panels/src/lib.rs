@@ -258,7 +258,8 @@ fn draw_panels(
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 let mut edited = replay.clone();
-                replay_panel(ui, &mut edited, &replay_path);
+                let planned = shown.as_ref().and_then(|s| s.figures).map(|(_, t)| t);
+                replay_panel(ui, &mut edited, &replay_path, planned);
                 replay.set_if_neq(edited);
                 ui.separator();
                 let (path, verdict) = toolpath.iter().next().unzip();
@@ -321,7 +322,10 @@ fn draw_source_previews(
     Ok(())
 }
 
-fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
+/// The replay's controls. The replay plays at the path's own speeds; its clock is shown in the
+/// printer's time, `planned_s` (the motion planner's estimate, the status line's) over the
+/// path's time at those speeds, so that its end reads what the status line and the G-code say.
+fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath, planned_s: Option<f64>) {
     ui.heading("Nozzle replay");
     ui.label(
         egui::RichText::new(
@@ -352,7 +356,15 @@ fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath) {
         }
     });
     let mut t = replay.time_s;
-    let label = format!("{} / {}", format_duration(t), format_duration(total));
+    let clock = planned_s
+        .map(|p| p / total)
+        .filter(|k| k.is_finite() && *k > 0.0)
+        .unwrap_or(1.0);
+    let label = format!(
+        "{} / {}",
+        format_duration(t * clock),
+        format_duration(total * clock)
+    );
     let scrub = ui.add(
         egui::Slider::new(&mut t, 0.0..=total.max(1e-3))
             .show_value(false)
@@ -588,6 +600,29 @@ mod tests {
         );
         let named = h.query_all_by_label_contains("droop: layer").count();
         assert!((1..=3).contains(&named), "{named} droops named");
+    }
+
+    /// The replay's clock reads the printer's time: its end is the planned time the status
+    /// line and the G-code give, not the time at the path's own speeds.
+    #[test]
+    fn the_replay_clock_ends_at_the_planned_time() {
+        let design = clayloft_core::load::parse_design(
+            "version = 1\n[shape]\nheight = 20.0\nsamples = 90\nlower = { type = \"rose\", radius = 40.0, amplitude = 6.0, petals = 5 }\nupper = { type = \"circle\", radius = 35.0 }\n",
+        )
+        .unwrap();
+        let job = clayloft_core::run(&design).unwrap();
+        let planned = clayloft_core::gcode::summarize(&design, &job).estimated_time_s;
+        let path = ReplayPath::unchecked(&job.toolpath);
+        let nominal = path.timeline.total_s();
+        assert_ne!(format_duration(nominal), format_duration(planned));
+        let end = format!("0m 00s / {}", format_duration(planned));
+        let mut h = Harness::builder()
+            .with_size(egui::vec2(320.0, 300.0))
+            .build_ui(move |ui| {
+                replay_panel(ui, &mut Replay::default(), &path, Some(planned));
+            });
+        h.run();
+        assert!(h.query_by_label_contains(&end).is_some(), "{end}");
     }
 
     /// The program check's verdict in words: passing, refused (with why, and that the export
