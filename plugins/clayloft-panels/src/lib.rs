@@ -84,15 +84,9 @@ fn draw_panels(
     // The job's figures and the self-check of its program, each on a thread of its own once
     // per toolpath; the check once the toolpath has settled (not while a handle is dragged).
     let now = std::time::Instant::now();
-    let key = toolpath
-        .iter()
-        .next()
-        .map(|(tp, _)| std::sync::Arc::as_ptr(&tp.0) as usize);
-    let shown = key.map(|key| {
-        job_work.update(key, now, doc_now.design.constraints.enforce, || {
-            let design = doc_now.design.clone();
-            engine.current_job(&design).ok().map(|job| (design, job))
-        })
+    let shown = toolpath.iter().next().map(|(tp, _)| {
+        let key = figures::JobKey::new(&tp.0, &doc_now.design);
+        job_work.update(key, now, |design| engine.current_job(design).ok())
     });
     if shown.as_ref().is_some_and(|s| s.busy) {
         redraw.write(bevy::window::RequestRedraw);
