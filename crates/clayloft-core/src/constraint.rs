@@ -35,7 +35,7 @@ pub fn clamp_overhang(
     let n = sections.first().map_or(0, |s| s.points.len());
     let rows = sections.len();
     if start < rows
-        && (rows - start) * n >= PARALLEL_POINTS
+        && (rows - start) * n >= crate::parallel::PARALLEL_POINTS
         && sections.iter().all(|s| s.points.len() == n)
     {
         let parts = crate::parallel::ranges(n, 2 * MIN_PART_COLUMNS);
@@ -47,9 +47,6 @@ pub fn clamp_overhang(
     }
     clamp_by_rows(sections, from, tan_limit, enforce)
 }
-
-/// Points below which [`clamp_overhang`] runs on one core.
-const PARALLEL_POINTS: usize = 20_000;
 
 /// Fewest columns a core takes in [`clamp_overhang`].
 const MIN_PART_COLUMNS: usize = 64;

@@ -195,7 +195,7 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
         // A printer host's program in memory: the same refusal.
         let program = crate::gcode::program(&d, &job).unwrap();
-        let again = verify_program(&d, &program.text).err().expect("refused");
+        let again = verify_program(&d, &program.text).expect_err("refused");
         assert_eq!(again.to_string(), e.to_string());
         d.constraints.enforce = false;
         assert!(verify_program(&d, &program.text).is_ok());

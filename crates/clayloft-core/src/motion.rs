@@ -81,7 +81,7 @@ impl Moves for [Move] {
 }
 
 /// Moves below which the planner stays on one core (starting a thread costs more).
-const SERIAL_BELOW: usize = 20_000;
+const SERIAL_BELOW: usize = crate::parallel::PARALLEL_POINTS;
 
 /// Total time of `moves` starting at rest at `start` and ending at rest, s.
 ///

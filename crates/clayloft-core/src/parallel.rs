@@ -18,6 +18,11 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
+/// Points (or moves, or chords) of a pass below which it stays on one core: handing part of it
+/// to a helper costs more than it saves (a few microseconds to wake one, tens when the part's
+/// data is cold). Each stage's own cut-off, where it has one, is this.
+pub const PARALLEL_POINTS: usize = 20_000;
+
 /// Threads worth starting for independent work: the machine's cores (1 if unknown), asked once
 /// (on Linux the answer reads the cgroup files, a few system calls each time).
 pub fn cores() -> usize {

@@ -130,7 +130,7 @@ pub fn assess(
 ) -> Result<Printability, FieldError> {
     let body = crate::clay::resolve(design.clay.as_ref())?;
     let (droops, verdict) = crate::parallel::both(
-        toolpath.points.len() >= 20_000,
+        toolpath.points.len() >= crate::parallel::PARALLEL_POINTS,
         || droops(design, surface),
         || standing(design, &body, toolpath),
     );

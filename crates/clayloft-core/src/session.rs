@@ -755,7 +755,7 @@ fn finish_stages(
     });
     let points: usize = surface.sections.iter().map(|s| s.points.len()).sum();
     let view_beside = crate::parallel::cores() > 1
-        && points >= PARALLEL_POINTS
+        && points >= crate::parallel::PARALLEL_POINTS
         && view_key.as_ref().is_some_and(|k| !later.view.is_current(k));
     let mut build_view = Some({
         let (surface, beads, limit) =
@@ -832,15 +832,14 @@ fn finish_stages(
     Ok(())
 }
 
-/// Below this many wall points a section batch is shaped on one thread (spawning costs more).
-const PARALLEL_POINTS: usize = 20_000;
-
 /// Shapes the sections `ks` of `model`, split over the machine's cores when there is enough work.
 fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<Section> {
     let per_section = model.loft.samples().max(1);
-    crate::parallel::map_ranges(ks.len(), PARALLEL_POINTS / per_section, |r| {
-        ks[r].iter().map(|&k| model.section(k)).collect()
-    })
+    crate::parallel::map_ranges(
+        ks.len(),
+        crate::parallel::PARALLEL_POINTS / per_section,
+        |r| ks[r].iter().map(|&k| model.section(k)).collect(),
+    )
 }
 
 #[cfg(test)]

@@ -503,8 +503,11 @@ fn measure_layers_in(
         radius
     };
     // The path's length up to each point on a second core while this one finds the chords.
-    let (cum, chords) =
-        crate::parallel::both(v.len() >= 20_000, || running_length(v), || chords(v));
+    let (cum, chords) = crate::parallel::both(
+        v.len() >= crate::parallel::PARALLEL_POINTS,
+        || running_length(v),
+        || chords(v),
+    );
     let index = match search {
         // The tree holds what the grid holds, and is never too large to build.
         Search::Tree => Some(ChordIndex::Tree(ChordTree::build(
@@ -525,7 +528,7 @@ fn measure_layers_in(
             2.0 * near_radius,
             &inside,
             INSERTIONS_BASE.saturating_add(INSERTIONS_PER_CHORD.saturating_mul(chords.len())),
-            20_000,
+            crate::parallel::PARALLEL_POINTS,
         )
         .map(ChordIndex::Grid),
     };
@@ -915,7 +918,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
     fn all(&self, budget: usize) -> Vec<Below> {
         let n = self.v.len();
         let threads = crate::parallel::cores().clamp(1, 8);
-        if threads < 2 || n < 20_000 {
+        if threads < 2 || n < crate::parallel::PARALLEL_POINTS {
             return self.range(0..n, budget);
         }
         let chunk = n.div_ceil(threads);
@@ -954,7 +957,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
     fn proves_all(&self, budget: usize, limits: LayerLimits) -> bool {
         let n = self.v.len();
         let threads = crate::parallel::cores().clamp(1, 8);
-        if threads < 2 || n < 20_000 {
+        if threads < 2 || n < crate::parallel::PARALLEL_POINTS {
             return self.proves(0..n, budget, limits);
         }
         let chunk = n.div_ceil(threads);

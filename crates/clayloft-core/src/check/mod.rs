@@ -190,7 +190,7 @@ fn extruding_path(
     let (p0, p1) = vertices.spare_capacity_mut()[..count].split_at_mut(half);
     let (l0, l1) = lines.spare_capacity_mut()[..count].split_at_mut(half);
     crate::parallel::both(
-        count >= 20_000,
+        count >= crate::parallel::PARALLEL_POINTS,
         || fill(0, p0, l0),
         || {
             beside();
