@@ -403,6 +403,25 @@ fn bad_wall_beads_exit_2_naming_the_field() {
             .as_bytes(),
         &["shape.walls", "layer 0", "narrower than 3 beads"],
     );
+    // The shipped two-bead star bowl on the WASP, whose 0.6 mm layers hold two turns of its
+    // 0.3 mm minimum but whose first revolution would end 0.9 mm over the base (it may lay 0.8):
+    // said by the validator, with the way out, not by the self-check's "layer too thin".
+    let out = clayloft(&[
+        "gcode",
+        "assets/designs/star-bowl.toml",
+        "--printer",
+        "wasp-2040-clay",
+        "-o",
+        "/dev/null",
+    ]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("shape.walls")
+            && err.contains("first revolution ends 0.900 mm")
+            && err.contains("fewer beads"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -14,6 +14,8 @@ pub enum FindingKind {
     Texture,
     /// The base fill: a foot narrower than a bead somewhere.
     Base,
+    /// The wall's layers where the spiral leaves the flat layer (the path ahead of the design).
+    Layers,
 }
 
 /// One correction or violation, over a range of layers.

@@ -319,26 +319,39 @@ pub fn build_toolpath_on(
             let frac = &fractions[(k - first) * walls + t];
             let below = &mut z_below[t];
             z_now[0] = below[0];
+            // The turn as the sections place it (from the flat layer on the first revolution),
+            // then lifted where it must be (see [`turn_lift`]).
+            let lo_z = |j: usize| if k == first { flat_z } else { lo.points[j].z };
+            let scheduled = |i: usize, j: usize| {
+                lo_z(j) + (hi.points[j].z - lo_z(j)) * (t as f64 + frac[i]) * share
+            };
+            // The first turn leaves the flat layer; every other goes on from where the path is.
+            let path_z = b.points.last().map_or(flat_z, |q| q.pos.z);
+            let lift = turn_lift(
+                [scheduled(0, 0), scheduled(n, 0)],
+                path_z,
+                below[0],
+                a,
+                k == first && t == 0,
+                walls > 1,
+            );
             for i in from..=n {
                 let f = (t as f64 + frac[i]) * share;
                 // i = n closes the turn at point 0 (compared: a division per point costs more).
                 let j = if i == n { 0 } else { i };
-                let (z, g) = if k == first {
-                    // Leave the flat layer by at least the minimum layer height; XY follows the z
-                    // progress so the lean never exceeds that of the sections.
-                    let z0 = flat_z + a;
-                    let z = z0 + (hi.points[j].z - z0) * f;
+                let z = scheduled(i, j) + lift[0] + (lift[1] - lift[0]) * frac[i];
+                // XY from the sections at the turn's fraction; on the first revolution at its
+                // height's progress from the flat layer, so that the lean never exceeds that of
+                // the sections where it starts above it.
+                let g = if k == first {
                     let rise = hi.points[j].z - flat_z;
-                    (
-                        z,
-                        if rise > 0.0 {
-                            ((z - flat_z) / rise).clamp(0.0, 1.0)
-                        } else {
-                            f
-                        },
-                    )
+                    if rise > 0.0 {
+                        ((z - flat_z) / rise).clamp(0.0, 1.0)
+                    } else {
+                        f
+                    }
                 } else {
-                    (lo.points[j].z + (hi.points[j].z - lo.points[j].z) * f, f)
+                    f
                 };
                 let xy = lo.points[j].truncate().lerp(hi.points[j].truncate(), g);
                 // Consecutive revolutions measure arc length along slightly different sections,
@@ -359,6 +372,27 @@ pub fn build_toolpath_on(
     }
 
     faulted.join();
+
+    // Where the first revolution's rise put the wall ahead of the sections and it never caught
+    // up (min_layer_height = the layer height), the vessel ends that much taller: say so.
+    if layers > first {
+        let top = &beads[0][layers];
+        let ahead = (0..n)
+            .map(|j| z_below[0][j] - top.points[j].z)
+            .fold(0.0, f64::max);
+        if ahead > 1e-3 {
+            findings.push(Finding {
+                kind: FindingKind::Layers,
+                corrected: true,
+                layers: (first + 1, layers),
+                points: n,
+                amount_mm: ahead,
+                message: format!(
+                    "the wall ends up to {ahead:.2} mm above the design's height: it leaves the flat layer by min_layer_height ({a} mm) and rises at least that much a revolution, so with layers of {h:.2} mm it cannot come back onto them"
+                ),
+            });
+        }
+    }
 
     // 4. Levelled rim: a flat turn at the top section's height on each bead, while the layer
     //    under it is at least min_layer_height thinner (the innermost bead's turn stops where it
@@ -401,6 +435,52 @@ pub fn build_toolpath_on(
         revolutions,
         layer_starts,
         findings,
+    })
+}
+
+/// How far a turn of a bead is lifted above where the sections place it, at its start and at
+/// its end (linear in between): `scheduled` its start and end heights at point 0, `path_z` the
+/// height the path has reached (the end of the turn before), `below_end` where this bead's last
+/// turn ended at point 0 (the flat layer before the first revolution), `a` the minimum layer
+/// height, `leaves_flat` whether this is the wall's first turn, which starts a above the flat
+/// layer, `steps_onto` whether the turn starts with a step across onto point 0 (a wall of several
+/// beads) rather than from the end of the bead's last turn.
+///
+/// A turn goes on level from where the path is (one bead steps across to the next at one
+/// height), starts at least a above the end of the bead's last turn where it steps onto it, and
+/// ends at least a above its own start, which lies under its end at point 0. On the sections' layers all of that
+/// holds (h/W ≥ a, checked by the validator), and nothing is lifted but where the wall leaves
+/// the flat layer: with a > h/(2W) its first turns end above the sections, and the turns after
+/// them are lifted as far as they must be until the wall is back on the sections (a wall whose
+/// layers hold no slack, h/W = a, never is: it ends that much taller, and the toolpath says
+/// so).
+fn turn_lift(
+    scheduled: [f64; 2],
+    path_z: f64,
+    below_end: f64,
+    a: f64,
+    leaves_flat: bool,
+    steps_onto: bool,
+) -> [f64; 2] {
+    let start = if leaves_flat {
+        scheduled[0].max(path_z + a)
+    } else if steps_onto {
+        scheduled[0].max(path_z).max(below_end + a)
+    } else {
+        scheduled[0].max(path_z)
+    };
+    let end = scheduled[1].max(start + a);
+    [start - scheduled[0], end - scheduled[1]]
+}
+
+/// How high above the flat layer the wall's first revolution ends on layers of height `h` with
+/// `walls` beads and a minimum layer height `a` (the lifts of [`turn_lift`]): its first turn
+/// ends at max(h/W, 2a), each next one at max((t+1)·h/W, the one before + a). All of it lies on
+/// the flat layer, so it must be a layer the printer can lay.
+pub fn first_revolution_top(h: f64, a: f64, walls: usize) -> f64 {
+    let w = walls.max(1) as f64;
+    (1..walls.max(1)).fold((h / w).max(2.0 * a), |end, t| {
+        ((t + 1) as f64 * h / w).max(end + a)
     })
 }
 
@@ -505,6 +585,73 @@ mod tests {
             );
         }
         assert!((pts.last().unwrap().pos.z - 20.0).abs() < 1e-9);
+    }
+
+    /// Where the printer's minimum layer height is more than half the layer height (up to all of
+    /// it), the wall still leaves the flat layer (a base, or the flat first revolution) as one
+    /// helix: no step, every point and every layer the checker measures within the printer's
+    /// range, and the vessel only as much taller as it must be, said in a finding. The first
+    /// revolution used to rise by h − a: with a = h it was a flat ring, and so was every one
+    /// after it, joined by steps that the next ring's end passed over a layer too thin.
+    #[test]
+    fn a_wall_leaves_the_flat_layer_as_one_helix_whatever_the_minimum_layer() {
+        for (min, base) in [(0.5, 0), (0.5, 2), (0.35, 0), (0.35, 2), (0.25, 2)] {
+            let d = parse_design(&format!(
+                "version = 1\n[printer]\nlayer_height = 0.5\nmin_layer_height = {min}\nmax_layer_height = 1.0\n[shape]\nheight = 20.0\nsamples = 90\nbase_layers = {base}\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 33.0\n"
+            ))
+            .unwrap();
+            let job = run(&d).unwrap();
+            let tp = &job.toolpath;
+            let wall = &tp.points[tp.base_points..];
+            let case = format!("min {min}, base {base}");
+            // One helix: z never falls, and rises at most a layer's share of a revolution from
+            // one point to the next (a step of a whole layer was the fault), but where the
+            // wall leaves the flat layer (by min_layer_height).
+            let leave = wall
+                .windows(2)
+                .position(|s| s[1].pos.z > s[0].pos.z + 1e-9)
+                .unwrap();
+            for s in wall[leave + 1..].windows(2) {
+                let rise = s[1].pos.z - s[0].pos.z;
+                assert!((-1e-9..0.05).contains(&rise), "{case}: rise {rise}");
+            }
+            for q in wall {
+                assert!(
+                    (min - 1e-9..=1.0 + 1e-9).contains(&q.thickness),
+                    "{case}: {}",
+                    q.thickness
+                );
+            }
+            let positions: Vec<DVec3> = tp.points.iter().map(|q| q.pos).collect();
+            let report =
+                crate::check::check_path(&positions, &crate::check::Limits::from(&d.printer));
+            assert!(report.ok(), "{case}: {:?}", report.violations);
+            // Taller only where the wall cannot catch up with the sections (a = h), and said.
+            let top = tp.points.iter().map(|q| q.pos.z).fold(0.0, f64::max);
+            let ahead = tp.findings.iter().find(|f| f.kind == FindingKind::Layers);
+            if min == 0.5 {
+                assert!((top - 20.5).abs() < 1e-6, "{case}: top {top}");
+                let f = ahead.expect("the taller wall is reported");
+                assert!((f.amount_mm - 0.5).abs() < 1e-6 && f.message.contains("0.50 mm above"));
+            } else {
+                assert!((top - 20.0).abs() < 1e-6, "{case}: top {top}");
+                assert!(ahead.is_none(), "{case}: {ahead:?}");
+            }
+        }
+    }
+
+    /// The first revolution's height over the flat layer, against the turns worked by hand.
+    #[test]
+    fn first_revolution_tops_follow_the_turns() {
+        // One bead: the layer, or twice the minimum when that is more.
+        assert_eq!(first_revolution_top(1.0, 0.25, 1), 1.0);
+        assert_eq!(first_revolution_top(0.5, 0.5, 1), 1.0);
+        // Two beads of 0.3 mm turns on 0.6 mm layers (the WASP's): 0.6, then 0.9.
+        assert!((first_revolution_top(0.6, 0.3, 2) - 0.9).abs() < 1e-12);
+        // The paper's printer: turns of 0.5 over a = 0.25 stay on the layers.
+        assert_eq!(first_revolution_top(1.0, 0.25, 2), 1.0);
+        // Three beads of 1/3 over a = 0.3: 0.6, 0.9, 1.2.
+        assert!((first_revolution_top(1.0, 0.3, 3) - 1.2).abs() < 1e-12);
     }
 
     #[test]

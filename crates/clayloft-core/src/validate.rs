@@ -65,9 +65,11 @@ fn in_range(field: &str, v: f64, lo: f64, hi: f64, why: &str) -> Check {
     Ok(())
 }
 
-/// The wall's beads (SPEC §13): 1 ..= [`crate::walls::MAX_WALLS`]; ties need a second bead; and
-/// where a bead steps to the next once per turn, the seam's layer (the pitch less the rise of one
-/// turn, `layer_height · (1 − 1/walls)`) must still be one the printer can lay.
+/// The wall's beads (SPEC §13): 1 ..= [`crate::walls::MAX_WALLS`]; ties need a second bead;
+/// each bead's turn must rise at least `min_layer_height` (it ends over its own start), so the
+/// layer height must hold W of them; and the first revolution, which leaves the flat layer by
+/// `min_layer_height` ([`crate::toolpath::first_revolution_top`]), must be a layer the printer
+/// can lay.
 fn walls(s: &crate::design::Shape, p: &Printer) -> Check {
     let max = crate::walls::MAX_WALLS;
     if s.walls < 1 || s.walls > max {
@@ -82,19 +84,35 @@ fn walls(s: &crate::design::Shape, p: &Printer) -> Check {
             "ties join the beads of a wall of two or three beads: set walls = 2 or 3",
         ));
     }
-    if s.walls > 1 {
-        let seam = p.layer_height * (1.0 - 1.0 / s.walls as f64);
-        if seam < p.min_layer_height {
-            return Err(FieldError::new(
-                "shape.walls",
-                format!(
-                    "with {} beads each turn rises {:.3} mm, so where a bead starts its layer is {seam:.3} mm, less than printer.min_layer_height = {} mm (a taller layer_height or fewer beads)",
-                    s.walls,
-                    p.layer_height / s.walls as f64,
-                    p.min_layer_height
-                ),
-            ));
-        }
+    let (h, a, w) = (p.layer_height, p.min_layer_height, s.walls);
+    if w > 1 && h < w as f64 * a * (1.0 - 1e-9) {
+        return Err(FieldError::new(
+            "shape.walls",
+            format!(
+                "with {w} beads each turn rises {:.3} mm and ends over its own start, less than printer.min_layer_height = {a} mm (a taller layer_height, a lower min_layer_height if the clay takes it, or fewer beads)",
+                h / w as f64
+            ),
+        ));
+    }
+    let top = crate::toolpath::first_revolution_top(h, a, w);
+    if top > p.max_layer_height * (1.0 + 1e-9) {
+        let beads = if w > 1 {
+            format!("its {w} turns each rise at least min_layer_height, so ")
+        } else {
+            String::new()
+        };
+        return Err(FieldError::new(
+            if w > 1 {
+                "shape.walls"
+            } else {
+                "printer.min_layer_height"
+            },
+            format!(
+                "the wall leaves the flat layer by printer.min_layer_height = {a} mm and {beads}its first revolution ends {top:.3} mm above that layer, more than printer.max_layer_height = {} mm (a lower min_layer_height if the clay takes it{})",
+                p.max_layer_height,
+                if w > 1 { ", or fewer beads" } else { "" }
+            ),
+        ));
     }
     Ok(())
 }
@@ -558,5 +576,39 @@ mod tests {
         let all = validate_all(&bad);
         assert!(all.iter().any(|e| e.field == "shape.height"), "{all:?}");
         assert!(all.len() <= MAX_REPORTED);
+    }
+
+    /// A wall must be able to leave the flat layer: each bead's turn rises at least the minimum
+    /// layer height, and the first revolution must be a layer the printer can lay.
+    #[test]
+    fn walls_that_cannot_leave_the_flat_layer_are_refused_with_why() {
+        let printer = |h: f64, a: f64, max: f64, walls: usize| {
+            let mut d = design(&format!(
+                "[printer]\nlayer_height = {h}\nmin_layer_height = {a}\nmax_layer_height = {max}\n"
+            ));
+            d.shape.walls = walls;
+            d
+        };
+        // The paper's printer: two and three beads.
+        assert_eq!(validate(&printer(1.0, 0.25, 1.0, 2)), Ok(()));
+        assert_eq!(validate(&printer(1.0, 0.25, 1.0, 3)), Ok(()));
+        // One bead of the Klipper delta's 0.5 mm at a = 0.5: the first revolution ends 1.0 up.
+        assert_eq!(validate(&printer(0.5, 0.5, 1.0, 1)), Ok(()));
+        // The Eazao's layers hold two beads, first revolution 1.5 mm: just.
+        assert_eq!(validate(&printer(1.0, 0.5, 1.5, 2)), Ok(()));
+        // The WASP's: 0.9 mm over the flat layer, past its 0.8.
+        let e = validate(&printer(0.6, 0.3, 0.8, 2)).unwrap_err();
+        assert_eq!(e.field, "shape.walls");
+        assert!(e.message.contains("ends 0.900 mm above"), "{}", e.message);
+        // Three beads of 0.2 mm turns over a = 0.3.
+        let e = validate(&printer(0.6, 0.3, 0.8, 3)).unwrap_err();
+        assert!(
+            e.message.contains("each turn rises 0.200 mm"),
+            "{}",
+            e.message
+        );
+        // One bead whose minimum is more than half the maximum.
+        let e = validate(&printer(0.8, 0.6, 1.0, 1)).unwrap_err();
+        assert_eq!(e.field, "printer.min_layer_height");
     }
 }
