@@ -89,7 +89,7 @@ fn walls(s: &crate::design::Shape, p: &Printer) -> Check {
         return Err(FieldError::new(
             "shape.walls",
             format!(
-                "with {w} beads each turn rises {:.3} mm and ends over its own start, less than printer.min_layer_height = {a} mm (a taller layer_height, a lower min_layer_height if the clay takes it, or fewer beads)",
+                "with {w} beads each turn rises {:.3} mm and ends over its own start, outside the printer's range of layers (min_layer_height = {a} mm; a taller layer_height, a lower min_layer_height if the clay takes it, or fewer beads)",
                 h / w as f64
             ),
         ));
@@ -108,7 +108,7 @@ fn walls(s: &crate::design::Shape, p: &Printer) -> Check {
                 "printer.min_layer_height"
             },
             format!(
-                "the wall leaves the flat layer by printer.min_layer_height = {a} mm and {beads}its first revolution ends {top:.3} mm above that layer, more than printer.max_layer_height = {} mm (a lower min_layer_height if the clay takes it{})",
+                "the wall leaves the flat layer by printer.min_layer_height = {a} mm and {beads}its first revolution ends {top:.3} mm above that layer, outside the printer's range of layers (max_layer_height = {} mm; a lower min_layer_height if the clay takes it{})",
                 p.max_layer_height,
                 if w > 1 { ", or fewer beads" } else { "" }
             ),
