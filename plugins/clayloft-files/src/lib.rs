@@ -680,10 +680,10 @@ mod tests {
         assert!(!g.exists());
     }
 
-    /// Right first time from the app as from the command line: the flared bowl on the WASP
-    /// leans past its limit at one point of its program (which `clayloft gcode` refuses), so
-    /// "Export G-code" says what broke and writes nothing; the same bowl on the default printer
-    /// is written.
+    /// Right first time from the app as from the command line: the flared bowl on the Potterbot
+    /// Baby has a layer too thick at one point of its program (which `clayloft gcode` refuses),
+    /// so "Export G-code" says what broke and writes nothing; the same bowl on the default
+    /// printer is written.
     #[test]
     fn a_program_past_its_printers_limits_is_not_exported() {
         let dir = tempfile::tempdir().unwrap();
@@ -702,12 +702,12 @@ mod tests {
             finish_exports(&mut app);
             (app.world().resource::<FileStatus>().clone(), g)
         };
-        let (status, g) = export(Some("wasp-2040-clay"), "wasp.gcode");
+        let (status, g) = export(Some("potterbot-baby"), "potterbot.gcode");
         let m = status.message.unwrap();
         assert!(status.is_error, "{m}");
         assert!(
             m.contains("not written")
-                && m.contains("does not print on this printer (wasp-2040-clay)"),
+                && m.contains("does not print on this printer (potterbot-baby)"),
             "{m}"
         );
         assert!(!g.exists());

@@ -329,13 +329,14 @@ mod tests {
         assert!(s.check.is_none() && s.figures.is_some());
     }
 
-    /// The self-check's verdict is the export's: the flared bowl on the WASP (refused by
-    /// `clayloft gcode`) does not pass, with the same words; on the default printer it does.
+    /// The self-check's verdict is the export's: the flared bowl on the Potterbot Baby (refused
+    /// by `clayloft gcode`: one point of a base layer a layer too thick) does not pass, with the
+    /// same words; on the default printer it does.
     #[test]
     fn the_program_check_is_the_exports() {
         let bowl = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../assets/designs/flared-bowl.toml");
-        for (printer, passes) in [(Some("wasp-2040-clay"), false), (None, true)] {
+        for (printer, passes) in [(Some("potterbot-baby"), false), (None, true)] {
             let design = clayloft_core::load::load_design_using(&bowl, printer)
                 .unwrap()
                 .design;
@@ -346,7 +347,7 @@ mod tests {
             assert_eq!(verdict.is_ok(), passes, "{printer:?}: {verdict:?}");
             if let Err(why) = verdict {
                 assert!(
-                    why.starts_with("does not print on this printer (wasp-2040-clay)"),
+                    why.starts_with("does not print on this printer (potterbot-baby)"),
                     "{why}"
                 );
                 let dir = tempfile::tempdir().unwrap();

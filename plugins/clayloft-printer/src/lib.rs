@@ -347,13 +347,14 @@ mod tests {
         (name, fake)
     }
 
-    /// Right first time: the flared bowl's program leans past the WASP's limit at one point
-    /// (`clayloft gcode` refuses it), so printing it does not start, nor open the port.
+    /// Right first time: the flared bowl's program on the Potterbot Baby has a layer too thick
+    /// at one point (`clayloft gcode` refuses it), so printing it does not start, nor open the
+    /// port.
     #[test]
     fn a_program_past_the_printers_limits_is_not_started() {
         let bowl = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../assets/designs/flared-bowl.toml");
-        let design = clayloft_core::load::load_design_using(&bowl, Some("wasp-2040-clay"))
+        let design = clayloft_core::load::load_design_using(&bowl, Some("potterbot-baby"))
             .unwrap()
             .design;
         let job = clayloft_core::run(&design).unwrap();
@@ -362,7 +363,7 @@ mod tests {
             .expect("refused");
         assert!(
             e.starts_with(
-                "not printed: the design does not print on this printer (wasp-2040-clay)"
+                "not printed: the design does not print on this printer (potterbot-baby)"
             ),
             "{e}"
         );
