@@ -265,7 +265,15 @@ impl ShapeModel {
         let height = design.shape.height;
         let hmax = p.max_layer_height * LIMIT_MARGIN;
         let hmin = p.min_layer_height / LIMIT_MARGIN;
-        let nominal = (height / p.layer_height - 1e-9).ceil().max(1.0) as usize;
+        // Whole layers of at most the layer height; one fewer where those would be thinner than
+        // the printer lays (a minimum close to the layer height), while that fits its maximum.
+        let mut nominal = (height / p.layer_height - 1e-9).ceil().max(1.0) as usize;
+        while nominal > 1
+            && height / (nominal as f64) < p.min_layer_height
+            && height / ((nominal - 1) as f64) <= p.max_layer_height
+        {
+            nominal -= 1;
+        }
         let (g_min, g_max) = self.dz_gradient_range();
         let layers_for = |s: f64| {
             if s * g_max > 0.0 {
@@ -398,6 +406,27 @@ mod tests {
              points = [[90.0, {dz}], [270.0, -{dz}]]\n[constraints]\nenforce = {enforce}\n"
         ))
         .unwrap()
+    }
+
+    /// A height that is no whole number of layers gets one layer more, a little thinner, unless
+    /// that is thinner than the printer lays: then one fewer, a little thicker.
+    #[test]
+    fn layers_stay_within_the_printers_range_when_the_height_does_not_divide() {
+        let layers = |min: f64| {
+            let d = parse_design(&format!(
+                "version = 1\n[printer]\nlayer_height = 0.5\nmin_layer_height = {min}\n[shape]\nheight = 35.3\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n"
+            ))
+            .unwrap();
+            let s = build_surface(&d).unwrap();
+            (s.layers, s.layer_pitch)
+        };
+        let (n, pitch) = layers(0.25);
+        assert_eq!(n, 71);
+        assert!((pitch - 35.3 / 71.0).abs() < 1e-12);
+        // 35.3 / 71 = 0.497 mm is under a 0.499 mm minimum: 70 layers of 0.504 mm.
+        let (n, pitch) = layers(0.499);
+        assert_eq!(n, 70);
+        assert!((0.499..=1.0).contains(&pitch), "{pitch}");
     }
 
     #[test]

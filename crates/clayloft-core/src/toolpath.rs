@@ -844,9 +844,18 @@ mod properties {
         fn any_vessel_gives_one_printable_spiral(
             r_low in 20.0..60.0f64, r_up in 20.0..60.0f64, amp in 0.0..0.3f64, petals in 1usize..9,
             height in 10.0..80.0f64, belly in -10.0..10.0f64, base in 0usize..4, samples in 60usize..300,
+            half_layers in proptest::bool::ANY, min_share in 0.25..=1.0f64, walls in 1usize..3,
         ) {
+            // Layers of 1 mm or 0.5 mm, a minimum from a quarter of them up to all of them (at
+            // most half the printer's 1 mm maximum: the validator's bound for leaving the flat
+            // layer), one bead or two where the validator lets two leave it.
+            let layer: f64 = if half_layers { 0.5 } else { 1.0 };
+            let min = (layer * min_share).min(0.5);
+            let two_fit = layer >= 2.0 * min && super::first_revolution_top(layer, min, 2) <= 1.0;
+            let walls = if two_fit { walls } else { 1 };
             let d = parse_design(&format!(
-                "version = 1\n[shape]\nheight = {height}\nsamples = {samples}\nbase_layers = {base}\n\
+                "version = 1\n[printer]\nlayer_height = {layer}\nmin_layer_height = {min}\n\
+                 [shape]\nheight = {height}\nsamples = {samples}\nbase_layers = {base}\nwalls = {walls}\n\
                  [shape.lower]\ntype = \"circle\"\nradius = {r_low}\n\
                  [shape.upper]\ntype = \"rose\"\nradius = {r_up}\namplitude = {}\npetals = {petals}\n\
                  [[control.vertical]]\npoints = [[0.0, 0.0], [0.5, {belly}], [1.0, 0.0]]\n",
