@@ -13,9 +13,11 @@
 //! goes round the child to x (half a line width before e) and steps back out to q_out on the
 //! parent, leaving the parent's stretch from q_in to q_out out. The outline is the exception: the
 //! wall's first revolution rests on it (and, on a wall flaring at 45°, the next base layer's
-//! outline, a layer's height further out), and a bead-long notch under a wall at the overhang
+//! outline, a layer's height further out), and a half-bead notch under a wall at the overhang
 //! limit leans it past the limit; so a bridge from the outline steps back out to q_in itself, x
-//! a whole bead before e, and the outline is laid all round. Every point of a ring of level j + 1 lies exactly w from the ring of level j around it (the
+//! a whole bead before e, and the outline is laid all round.
+//!
+//! Every point of a ring of level j + 1 lies exactly w from the ring of level j around it (the
 //! offsets are erosions of the foot by growing discs), so both steps are one bead long and lie in
 //! the strip between the two rings, which no other ring enters; facing rings run in opposite
 //! directions (the orientation alternates), so the parent reaches q_in first and the two steps do

@@ -5,8 +5,9 @@
 //! Every point carries the local layer thickness (its z minus the z of the point one revolution
 //! below), which sets the extrusion. The helix starts `min_layer_height` above the flat
 //! revolution so that no point is ever thinner than the printer can lay (no 0-thickness wedge),
-//! and the rim is levelled by a partial flat revolution that stops where the thickness would fall
-//! below `min_layer_height`.
+//! and each turn rises at least that much, since the next lies on it ([`turn_lift`]); the rim is
+//! levelled by a partial flat revolution that stops where the thickness would fall below
+//! `min_layer_height`.
 
 use glam::{DVec2, DVec3};
 
@@ -448,12 +449,12 @@ pub fn build_toolpath_on(
 ///
 /// A turn goes on level from where the path is (one bead steps across to the next at one
 /// height), starts at least a above the end of the bead's last turn where it steps onto it, and
-/// ends at least a above its own start, which lies under its end at point 0. On the sections' layers all of that
-/// holds (h/W ≥ a, checked by the validator), and nothing is lifted but where the wall leaves
-/// the flat layer: with a > h/(2W) its first turns end above the sections, and the turns after
-/// them are lifted as far as they must be until the wall is back on the sections (a wall whose
-/// layers hold no slack, h/W = a, never is: it ends that much taller, and the toolpath says
-/// so).
+/// ends at least a above its own start, which lies under its end at point 0. On the sections'
+/// layers all of that holds (h/W ≥ a, checked by the validator), and nothing is lifted but
+/// where the wall leaves the flat layer: with a > h/(2W) its first turns end above the
+/// sections, and the turns after them are lifted as far as they must be until the wall is back
+/// on the sections (a wall whose layers hold no slack, h/W = a, never is: it ends that much
+/// taller, and the toolpath says so).
 fn turn_lift(
     scheduled: [f64; 2],
     path_z: f64,
