@@ -5,7 +5,7 @@
 //! Every point carries the local layer thickness (its z minus the z of the point one revolution
 //! below), which sets the extrusion. The helix starts `min_layer_height` above the flat
 //! revolution so that no point is ever thinner than the printer can lay (no 0-thickness wedge),
-//! and each turn rises at least that much, since the next lies on it ([`turn_lift`]); the rim is
+//! and each turn rises at least that much, since the next lies on it (`turn_lift`); the rim is
 //! levelled by a partial flat revolution that stops where the thickness would fall below
 //! `min_layer_height`.
 
@@ -475,7 +475,7 @@ fn turn_lift(
 }
 
 /// How high above the flat layer the wall's first revolution ends on layers of height `h` with
-/// `walls` beads and a minimum layer height `a` (the lifts of [`turn_lift`]): its first turn
+/// `walls` beads and a minimum layer height `a` (the lifts of `turn_lift`): its first turn
 /// ends at max(h/W, 2a), each next one at max((t+1)·h/W, the one before + a). All of it lies on
 /// the flat layer, so it must be a layer the printer can lay.
 pub fn first_revolution_top(h: f64, a: f64, walls: usize) -> f64 {
