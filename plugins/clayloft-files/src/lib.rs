@@ -680,14 +680,14 @@ mod tests {
         assert!(!g.exists());
     }
 
-    /// Right first time from the app as from the command line: the flared bowl on the Potterbot
-    /// Baby has a layer too thick at one point of its program (which `clayloft gcode` refuses),
-    /// so "Export G-code" says what broke and writes nothing; the same bowl on the default
+    /// Right first time from the app as from the command line: the petal vase on the Potterbot
+    /// Baby has a layer too thick at 7 points of its program (which `clayloft gcode` refuses),
+    /// so "Export G-code" says what broke and writes nothing; the same vase on the default
     /// printer is written.
     #[test]
     fn a_program_past_its_printers_limits_is_not_exported() {
         let dir = tempfile::tempdir().unwrap();
-        let bowl = design_path().with_file_name("flared-bowl.toml");
+        let bowl = design_path().with_file_name("petal-vase.toml");
         let export = |printer: Option<&str>, name: &str| {
             let mut app = app(dir.path());
             let design = clayloft_core::load::load_design_using(&bowl, printer)

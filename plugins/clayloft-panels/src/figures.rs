@@ -329,13 +329,13 @@ mod tests {
         assert!(s.check.is_none() && s.figures.is_some());
     }
 
-    /// The self-check's verdict is the export's: the flared bowl on the Potterbot Baby (refused
-    /// by `clayloft gcode`: one point of a base layer a layer too thick) does not pass, with the
-    /// same words; on the default printer it does.
+    /// The self-check's verdict is the export's: the petal vase on the Potterbot Baby (refused
+    /// by `clayloft gcode`: 5 mm beads where the tilted rim meets the rose's cusps, a layer too
+    /// thick at 7 points) does not pass, with the same words; on the default printer it does.
     #[test]
     fn the_program_check_is_the_exports() {
         let bowl = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../assets/designs/flared-bowl.toml");
+            .join("../../assets/designs/petal-vase.toml");
         for (printer, passes) in [(Some("potterbot-baby"), false), (None, true)] {
             let design = clayloft_core::load::load_design_using(&bowl, printer)
                 .unwrap()

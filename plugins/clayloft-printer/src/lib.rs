@@ -347,13 +347,13 @@ mod tests {
         (name, fake)
     }
 
-    /// Right first time: the flared bowl's program on the Potterbot Baby has a layer too thick
-    /// at one point (`clayloft gcode` refuses it), so printing it does not start, nor open the
+    /// Right first time: the petal vase's program on the Potterbot Baby has a layer too thick
+    /// at 7 points (`clayloft gcode` refuses it), so printing it does not start, nor open the
     /// port.
     #[test]
     fn a_program_past_the_printers_limits_is_not_started() {
         let bowl = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../assets/designs/flared-bowl.toml");
+            .join("../../assets/designs/petal-vase.toml");
         let design = clayloft_core::load::load_design_using(&bowl, Some("potterbot-baby"))
             .unwrap()
             .design;

@@ -485,6 +485,7 @@ fn measure_layers_in(
     let radius = limits.line_width + 2.0 * limits.max_layer_height * tan_max;
     let gap = 3.0 * radius;
     let below_tol = 0.25 * limits.min_layer_height;
+    let stepped_up = limits.min_layer_height - LayerLimits::of(limits).height_tol;
     let reach = 2.0 * limits.max_layer_height + below_tol;
     let margin = 2.0 * radius + 10.0;
     let inside = |p: DVec3| {
@@ -553,6 +554,7 @@ fn measure_layers_in(
             radius,
         ),
         gap,
+        stepped_up,
         below_tol,
         reach,
         half_bead: 0.5 * limits.line_width,
@@ -903,6 +905,10 @@ struct LayerSearch<'a, F: Fn(DVec3) -> bool + Sync> {
     /// See [`short_chord2`].
     short2: f32,
     gap: f64,
+    /// A spot at least this far below the point (a minimum layer, less the tolerance) is a layer
+    /// the path has stepped up from within a few beads (a base's next layer starting a layer up
+    /// and out at a 45° flare, a wall leaving its base), never the bead just laid.
+    stepped_up: f64,
     below_tol: f64,
     reach: f64,
     half_bead: f64,
@@ -1262,10 +1268,12 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         let zq = a.z + (b.z - a.z) * f;
         // The bead just laid: reached from p along an almost straight stretch of path. Where
         // the path has come back over itself (the next revolution, the centre of a spiral base)
-        // the layer below is much nearer in XY than along the path.
+        // the layer below is much nearer in XY than along the path; where it has stepped up a
+        // whole layer on the way (a base's next layer starting a layer up and out, under a wall
+        // flaring at 45° with beads of 5 mm), what it left is the layer below.
         let cum = self.cum;
         let along = cum[j] - (cum[ia] + f * (cum[ib] - cum[ia]));
-        if along < self.gap && d >= 0.5 * along {
+        if along < self.gap && d >= 0.5 * along && p.z - zq < self.stepped_up {
             return;
         }
         if zq <= z[1] && zq >= z[0] {
@@ -1465,6 +1473,42 @@ mod tests {
     /// Cones of stacked rings leaning a steady angle: within the limit they are shown to hold;
     /// past it (up to the steepest a spot within half a bead can witness, 62° at 0.8 mm
     /// layers and a 3 mm bead) they are not, and the full measurement finds the overhang.
+    /// Flat rings of 5 mm beads 2.5 mm apart, each 2.45 mm further out (leaning 44.4°), each
+    /// run the other way round from the one below and joined to it by one step up and out, as
+    /// a big bead's base flares under a 45° wall: each ring rests on the one below all round.
+    /// The first points after each step used to find the ring just left to be "the bead just
+    /// laid" (a few bead widths back along an almost straight path) and so nothing, or only the
+    /// ring two down, under them: a layer too thick, or leaning 71°.
+    #[test]
+    fn a_ring_stepped_up_a_layer_rests_on_the_ring_it_left() {
+        let printer = Printer {
+            line_width: 5.0,
+            layer_height: 2.5,
+            min_layer_height: 1.25,
+            max_layer_height: 2.5,
+            ..Printer::default()
+        };
+        let limits = Limits::from(&printer);
+        let per_ring = 400;
+        let mut v = Vec::new();
+        for k in 0..5 {
+            let (z, r) = (2.5 * (k + 1) as f64, 40.0 + 2.45 * k as f64);
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            for i in 0..=per_ring {
+                let a = sign * i as f64 / per_ring as f64 * std::f64::consts::TAU;
+                v.push(DVec3::new(100.0 + r * a.cos(), 100.0 + r * a.sin(), z));
+            }
+        }
+        let lines: Vec<usize> = (0..v.len()).collect();
+        let mut report = CheckReport::default();
+        measure_layers(&v, &lines, &limits, &mut report);
+        assert!(report.ok(), "{report}");
+        assert!(
+            (report.max_layer_height - 2.5).abs() < 1e-6 && report.max_overhang_deg < 45.0,
+            "{report}"
+        );
+    }
+
     #[test]
     fn witnesses_do_not_show_a_lean_past_the_limit() {
         let limits = Limits::from(&Printer::default());

@@ -4,12 +4,13 @@
 //!   no retraction anywhere.
 //! * Inside the machine: every move's end point on the bed and within 0 ..= max_z.
 //! * Layer height and overhang: for each path vertex p, the layer below is the topmost earlier
-//!   path (more than a few line widths back along the path, at least a quarter of the minimum
-//!   layer height lower) within half a bead in XY. Local layer height = p.z − z below; the lean
-//!   is the least `atan(d / Δz)` over the earlier paths within the search radius and two layers
-//!   down (d their XY distance, Δz how far below p): a leaning wall leans alike from every layer
-//!   under it, while a bead beside a thinner one (the beads of a wall of several, SPEC §13) but
-//!   resting on a layer beneath does not lean. Points low enough rest on the bed.
+//!   path (more than a few line widths back along the path, or a whole minimum layer lower, and
+//!   at least a quarter of the minimum layer height lower) within half a bead in XY. Local
+//!   layer height = p.z − z below; the lean is the least `atan(d / Δz)` over the earlier paths
+//!   within the search radius and two layers down (d their XY distance, Δz how far below p): a
+//!   leaning wall leans alike from every layer under it, while a bead beside a thinner one (the
+//!   beads of a wall of several, SPEC §13) but resting on a layer beneath does not lean. Points
+//!   low enough rest on the bed.
 //! * Collision: the highest earlier printed point may rise at most `nozzle_length` above the
 //!   nozzle tip (the holder is treated as a plane `nozzle_length` above the tip).
 //!
