@@ -317,8 +317,9 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
         m.max_layer_height
     );
     if let Ok(body) = clayloft_core::clay::resolve(d.clay.as_ref()) {
-        // The printed (wet) size, and what the kiln makes of it.
-        let (lo, hi) = job.surface.sections.iter().flat_map(|s| &s.points).fold(
+        // The printed (wet) size: the path's, which may end above the design (a wall that
+        // cannot come back onto its layers), and what the kiln makes of it.
+        let (lo, hi) = job.toolpath.points.iter().map(|q| &q.pos).fold(
             (
                 bevy::math::DVec3::splat(f64::INFINITY),
                 bevy::math::DVec3::splat(f64::NEG_INFINITY),

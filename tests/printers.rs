@@ -120,6 +120,16 @@ fn the_wall_leaves_the_base_on_every_printer_it_fits() {
             "{design} on {profile}: {}",
             text(&run.stderr)
         );
+        // The oval jar's 0.5 mm layers are the delta's minimum: its wall cannot come back onto
+        // them once it has left the base, and ends half a millimetre taller, as the summary says.
+        if (design, profile) == ("ellipse-ripple", "klipper-paste-delta") {
+            let said = text(&run.stdout);
+            assert!(
+                said.contains("x 70.5 mm wet")
+                    && said.contains("the wall ends up to 0.50 mm above"),
+                "{said}"
+            );
+        }
         let check = clayloft(&["check", out.to_str().unwrap()]);
         assert_eq!(check.status.code(), Some(0), "{}", text(&check.stdout));
     }
