@@ -265,11 +265,13 @@ impl ShapeModel {
         let height = design.shape.height;
         let hmax = p.max_layer_height * LIMIT_MARGIN;
         let hmin = p.min_layer_height / LIMIT_MARGIN;
-        // Whole layers of at most the layer height; one fewer where those would be thinner than
-        // the printer lays (a minimum close to the layer height), while that fits its maximum.
+        // Whole layers of at most the layer height; fewer where those would be thinner than the
+        // wall can be laid, while they fit the printer's maximum: each of W beads' turns rises at
+        // least the minimum layer height (the toolpath's turns), so a layer holds W of them.
+        let least = p.min_layer_height * design.shape.walls.max(1) as f64;
         let mut nominal = (height / p.layer_height - 1e-9).ceil().max(1.0) as usize;
         while nominal > 1
-            && height / (nominal as f64) < p.min_layer_height
+            && height / (nominal as f64) < least
             && height / ((nominal - 1) as f64) <= p.max_layer_height
         {
             nominal -= 1;
@@ -409,7 +411,8 @@ mod tests {
     }
 
     /// A height that is no whole number of layers gets one layer more, a little thinner, unless
-    /// that is thinner than the printer lays: then one fewer, a little thicker.
+    /// that is thinner than the wall can be laid (the printer's minimum, W of it for W beads):
+    /// then one fewer, a little thicker.
     #[test]
     fn layers_stay_within_the_printers_range_when_the_height_does_not_divide() {
         let layers = |min: f64| {
@@ -427,6 +430,13 @@ mod tests {
         let (n, pitch) = layers(0.499);
         assert_eq!(n, 70);
         assert!((0.499..=1.0).contains(&pitch), "{pitch}");
+        // Two beads of 0.25 mm turns at the least: 71 layers of 0.497 mm would not hold two.
+        let d = parse_design(
+            "version = 1\n[printer]\nlayer_height = 0.5\nmin_layer_height = 0.25\n[shape]\nheight = 35.3\nwalls = 2\n[shape.lower]\ntype = \"circle\"\nradius = 30.0\n[shape.upper]\ntype = \"circle\"\nradius = 30.0\n",
+        )
+        .unwrap();
+        let s = build_surface(&d).unwrap();
+        assert_eq!(s.layers, 70);
     }
 
     #[test]

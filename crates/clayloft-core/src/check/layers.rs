@@ -485,7 +485,8 @@ fn measure_layers_in(
     let radius = limits.line_width + 2.0 * limits.max_layer_height * tan_max;
     let gap = 3.0 * radius;
     let below_tol = 0.25 * limits.min_layer_height;
-    let stepped_up = limits.min_layer_height - LayerLimits::of(limits).height_tol;
+    let layer_limits = LayerLimits::of(limits);
+    let stepped_up = limits.min_layer_height - layer_limits.height_tol;
     let reach = 2.0 * limits.max_layer_height + below_tol;
     let margin = 2.0 * radius + 10.0;
     let inside = |p: DVec3| {
@@ -562,7 +563,6 @@ fn measure_layers_in(
         inside: &inside,
         every_chord: search == Search::EveryChord,
     };
-    let layer_limits = LayerLimits::of(limits);
     let budget = CANDIDATES_BASE.saturating_add(CANDIDATES_PER_POINT.saturating_mul(v.len()));
     let shown = first_show && measurable && search.proves_all(budget, layer_limits);
     // Shown or not measurable: no point's layers to tally (the holder's clearance only).
