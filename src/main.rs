@@ -160,6 +160,12 @@ fn quiet_on_broken_pipe() {
 fn main() -> ExitCode {
     quiet_on_broken_pipe();
     let cli = Cli::parse();
+    if matches!(
+        cli.command,
+        Some(Command::Gcode { .. } | Command::Stl { .. } | Command::Check { .. })
+    ) {
+        clayloft_core::heap::keep_freed_memory();
+    }
     let result = match cli.command {
         Some(Command::Gcode {
             design,

@@ -33,6 +33,7 @@ pub mod export;
 pub mod fields;
 pub mod gcode;
 pub mod geometry;
+pub mod heap;
 pub mod interp;
 pub mod load;
 pub mod loft;

@@ -383,18 +383,86 @@ impl GridPart {
     }
 }
 
+/// Points whose thin-layer bands are searched at once, at most (see
+/// [`LayerSearch::band_clear`]): a run about a bead long on a finely sampled wall.
+const BAND_RUN: usize = 16;
+
+/// Path points in a block of [`chords_and_lengths`]: no chord crosses a block's end, so that
+/// the blocks are found on every core and the chords are the same whatever their number.
+const CHORD_BLOCK: usize = 1 << 15;
+
 /// The path as chords `(i, k)`: each stands for path points `i ..= k`, all within
 /// [`CHORD_TOLERANCE_MM`] of the straight line from point `i` to point `k` (at most
-/// [`MAX_POINTS_PER_CHORD`] points). A finely sampled curve becomes chords about a millimetre
-/// long, whatever its sampling; a hostile file that zig-zags in one spot stays one chord per
-/// point but its cells are capped.
+/// [`MAX_POINTS_PER_CHORD`] points, and never across a multiple of [`CHORD_BLOCK`]). A finely
+/// sampled curve becomes chords about a millimetre long, whatever its sampling; a hostile file
+/// that zig-zags in one spot stays one chord per point but its cells are capped.
+#[cfg(test)]
 pub(super) fn chords(v: &[DVec3]) -> Vec<(usize, usize)> {
-    // Room for a chord a segment (pages are only taken as written): no copies as it grows.
-    let mut out = Vec::with_capacity(v.len().saturating_sub(1));
-    let mut i = 0;
-    while i + 1 < v.len() {
+    chords_and_lengths(v).0
+}
+
+/// The chords of path `v` (see [`chords`]) and its length up to each point, mm: block by
+/// block on every core.
+///
+/// The running length is summed within each block and the blocks' totals are added after, in
+/// path order: the same sums whatever the number of cores.
+fn chords_and_lengths(v: &[DVec3]) -> (Vec<(usize, usize)>, Vec<f64>) {
+    let segments = v.len().saturating_sub(1);
+    let mut cum = vec![0.0; v.len()];
+    // A block has at most a chord a segment: each is found into a room of that size, and the
+    // rooms are closed up after (no second buffer to copy them into).
+    let mut chords = vec![(0, 0); segments];
+    // Per block: its lengths (from its first point), its room for chords, and how many it has.
+    type Block<'a> = (&'a mut [f64], &'a mut [(usize, usize)], usize);
+    let mut blocks: Vec<Block> = cum
+        .get_mut(1..)
+        .unwrap_or_default()
+        .chunks_mut(CHORD_BLOCK)
+        .zip(chords.chunks_mut(CHORD_BLOCK))
+        .map(|(lengths, room)| (lengths, room, 0))
+        .collect();
+    crate::parallel::for_each_part(&mut blocks, 2, |offset, part| {
+        for (k, (lengths, room, count)) in part.iter_mut().enumerate() {
+            let first = (offset + k) * CHORD_BLOCK;
+            *count = chords_in(v, first, first + lengths.len(), room);
+            let mut sum = 0.0;
+            for (m, c) in lengths.iter_mut().enumerate() {
+                sum += v[first + m].distance(v[first + m + 1]);
+                *c = sum;
+            }
+        }
+    });
+    // The blocks' totals carried on, in path order; their chords' counts.
+    let mut carried = 0.0;
+    let counts: Vec<usize> = blocks
+        .into_iter()
+        .map(|(lengths, _, count)| {
+            let total = lengths.last().copied().unwrap_or(0.0);
+            if carried != 0.0 {
+                lengths.iter_mut().for_each(|c| *c += carried);
+            }
+            carried += total;
+            count
+        })
+        .collect();
+    let mut end = 0;
+    for (b, count) in counts.into_iter().enumerate() {
+        let at = b * CHORD_BLOCK;
+        chords.copy_within(at..at + count, end);
+        end += count;
+    }
+    chords.truncate(end);
+    (chords, cum)
+}
+
+/// Writes the chords of path points `first ..= last` (see [`chords`]) to the start of `room`
+/// (one place a segment); how many there are.
+fn chords_in(v: &[DVec3], first: usize, last: usize, room: &mut [(usize, usize)]) -> usize {
+    let mut count = 0;
+    let mut i = first;
+    while i < last {
         let mut k = i + 1;
-        while k + 1 < v.len() && k + 1 - i < MAX_POINTS_PER_CHORD {
+        while k < last && k + 1 - i < MAX_POINTS_PER_CHORD {
             let (a, b) = (v[i], v[k + 1]);
             let ab = b - a;
             let len2 = ab.length_squared();
@@ -408,19 +476,11 @@ pub(super) fn chords(v: &[DVec3]) -> Vec<(usize, usize)> {
             }
             k += 1;
         }
-        out.push((i, k));
+        room[count] = (i, k);
+        count += 1;
         i = k;
     }
-    out
-}
-
-/// The length of path `v` up to each of its points, mm.
-fn running_length(v: &[DVec3]) -> Vec<f64> {
-    let mut cum = vec![0.0; v.len()];
-    for j in 1..v.len() {
-        cum[j] = cum[j - 1] + v[j - 1].distance(v[j]);
-    }
-    cum
+    count
 }
 
 /// Measures the layers of an extruding path `v` (see the module documentation of
@@ -504,12 +564,7 @@ fn measure_layers_in(
     } else {
         radius
     };
-    // The path's length up to each point on a second core while this one finds the chords.
-    let (cum, chords) = crate::parallel::both(
-        v.len() >= crate::parallel::PARALLEL_POINTS,
-        || running_length(v),
-        || chords(v),
-    );
+    let (chords, cum) = chords_and_lengths(v);
     let index = match search {
         // The tree holds what the grid holds, and is never too large to build.
         Search::Tree => Some(ChordIndex::Tree(ChordTree::build(
@@ -1000,6 +1055,10 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
             NearColumns::default(),
         );
         let mut under: Option<usize> = None;
+        // Points before `clear_to` are shown free of thin layers by their run's search (see
+        // [`LayerSearch::band_clear`]); from `tried_to` on, a run is tried again.
+        let (mut clear_to, mut tried_to) = (0, 0);
+        let end = range.end;
         for j in range {
             let p = self.v[j];
             if j == 0 || !(self.inside)(p) {
@@ -1022,6 +1081,19 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
                 continue;
             }
             under = witness;
+            if j < clear_to {
+                continue;
+            }
+            if j >= tried_to {
+                match self.band_clear(j, end, limits, &mut thin, &mut budget) {
+                    None => return false,
+                    Some(k) if k > j => {
+                        clear_to = k;
+                        continue;
+                    }
+                    Some(_) => tried_to = j + BAND_RUN,
+                }
+            }
             let heights = [
                 p.z - limits.min_height + limits.height_tol,
                 p.z - self.below_tol,
@@ -1039,6 +1111,70 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
             }
         }
         true
+    }
+
+    /// The end of a short run of points from j (before `end`) shown to have no spot in any of
+    /// their thin-layer bands (see [`LayerSearch::proves`]) by one search of the tree around
+    /// the whole run; `Some(j)` when that search meets a chord that might hold one (each point
+    /// is then searched alone), or the index is not a tree; `None` once the budget is spent.
+    ///
+    /// The run: up to [`BAND_RUN`] points inside the machine, within half a bead of its first
+    /// in XY and rising less than the height tolerance from it (so that the run's band stays a
+    /// point's). Its search holds each point's: the chords laid before its last point, a circle
+    /// around the run's box holding each point's half-bead circle, and every point's heights.
+    fn band_clear(
+        &self,
+        j: usize,
+        end: usize,
+        limits: LayerLimits,
+        cache: &mut NearColumns,
+        budget: &mut usize,
+    ) -> Option<usize> {
+        let ChordIndex::Tree(tree) = self.index else {
+            return Some(j);
+        };
+        let first = self.v[j];
+        let run_end = (j..end.min(j + BAND_RUN))
+            .find(|&k| {
+                let q = self.v[k];
+                !(self.inside)(q)
+                    || q.truncate().distance(first.truncate()) > self.half_bead
+                    || q.z - first.z >= limits.height_tol
+                    || q.z < first.z
+            })
+            .unwrap_or(end.min(j + BAND_RUN));
+        if run_end < j + 2 {
+            return Some(j);
+        }
+        let run = &self.v[j..run_end];
+        let (lo, hi) = run.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), q| (lo.min(q.truncate()), hi.max(q.truncate())),
+        );
+        let z_lo = run.iter().map(|q| q.z).fold(f64::INFINITY, f64::min);
+        let z_hi = run.iter().map(|q| q.z).fold(f64::NEG_INFINITY, f64::max);
+        let z32 = [
+            ((z_lo - limits.min_height + limits.height_tol) as f32).next_down(),
+            ((z_hi - self.below_tol) as f32).next_up(),
+        ];
+        let centre = 0.5 * (lo + hi);
+        let r = self.half_bead + 0.5 * (hi - lo).length() + 1e-6;
+        let last = run_end - 1;
+        cache.laid = seek(self.chords, cache.laid, |&(_, e)| e <= last);
+        let mut met = false;
+        let visited = tree.visit(
+            centre,
+            r,
+            z32,
+            cache.laid,
+            &mut cache.first_leaf,
+            budget,
+            |id| met |= self.held(id),
+        );
+        if !visited {
+            return None;
+        }
+        Some(if met { j } else { run_end })
     }
 
     /// Whether chord `id`'s spot under point j is a witness that j keeps `limits` (see
@@ -1507,6 +1643,58 @@ mod tests {
             (report.max_layer_height - 2.5).abs() < 1e-6 && report.max_overhang_deg < 45.0,
             "{report}"
         );
+    }
+
+    /// A helix of 0.5 mm layers on a flat first revolution, with a bump: a few points of one
+    /// revolution raised up to 0.4 mm (0.9 mm over the layer below: not too thick), so that the
+    /// revolution above rests as little as 0.1 mm over them (thinner than the printer's
+    /// 0.25 mm). Each point over the bump has a witness (the bump under it, not too thick);
+    /// only the search of its thin-layer band finds the bump, also where a run of points is
+    /// searched at once and the bump lies under a few of them, at either end of the run.
+    #[test]
+    fn a_bump_under_a_run_of_points_is_a_layer_too_thin() {
+        let limits = Limits::from(&Printer::default());
+        let per_rev = 720;
+        // Up and down over a quarter of it each (no chord steeper than 45°: each point rests
+        // on one).
+        let ramp = |i: usize, bump: &std::ops::Range<usize>| {
+            let inside = (i as f64 - bump.start as f64).min(bump.end as f64 - 1.0 - i as f64);
+            (inside / (bump.len() / 4).max(2) as f64).clamp(0.0, 1.0)
+        };
+        let helix = |bump: std::ops::Range<usize>| -> Vec<DVec3> {
+            (0..per_rev * 14)
+                .map(|i| {
+                    let t = i as f64 / per_rev as f64;
+                    let a = t * std::f64::consts::TAU;
+                    let z = match t {
+                        t if t < 1.0 => 0.5,
+                        t if t < 2.0 => 0.75 + 0.25 * (t - 1.0),
+                        t => 0.5 + 0.5 * (t - 1.0),
+                    } + 0.4 * ramp(i, &bump);
+                    DVec3::new(100.0 + 40.0 * a.cos(), 100.0 + 40.0 * a.sin(), z)
+                })
+                .collect()
+        };
+        let lines: Vec<usize> = (0..per_rev * 14).collect();
+        let mut plain = CheckReport::default();
+        assert!(
+            layers_hold(&helix(0..0), &lines, &limits, &mut plain),
+            "{plain}"
+        );
+        // Long bumps, and bumps thin under one point only (wherever a run of points starts).
+        let short = (300..300 + BAND_RUN).map(|start| (start, 5));
+        for (start, len) in [(300, 10), (301, 13), (307, 16), (310, 24)]
+            .into_iter()
+            .chain(short)
+        {
+            let v = helix(10 * per_rev + start..10 * per_rev + start + len);
+            let (mut quick, mut full) = (CheckReport::default(), CheckReport::default());
+            measure_layers(&v, &lines, &limits, &mut full);
+            let thin = full.violations.iter().find(|x| x.what == "layer too thin");
+            assert!(thin.is_some_and(|x| x.count <= 2 * len), "{start}: {full}");
+            assert!(!layers_hold(&v, &lines, &limits, &mut quick), "{start}");
+            assert_eq!(quick, full);
+        }
     }
 
     #[test]
