@@ -128,32 +128,35 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
     summarize_beside(design, job, false, || ()).0
 }
 
-/// [`summarize`], with `beside` (the writer's thumbnails and print time) and the path's length
-/// run on a second core (when `use_beside` and one is free) while the motion planner's
-/// look-ahead passes and the clay's volume use this one (its entry limits use both cores
-/// first). For the benchmark vase the thumbnails and the estimate took 9.3 ms with the
-/// thumbnails beside the whole planner, 6 ms so.
+/// [`summarize`], with `beside` (the writer's thumbnails) run on a second core (when
+/// `use_beside` and one is free) while the motion planner's look-ahead passes, the clay's
+/// volume and the path's length and time at its own speeds use this one (the planner's entry
+/// limits use both cores first); with the time at the points' own speeds, s
+/// ([`Toolpath::print_time`]). For the benchmark vase the thumbnails and the estimate took
+/// 9.3 ms with the thumbnails beside the whole planner, 6 ms so; 2.9 ms with the length and
+/// time summed from the planner's move lengths instead of measured again beside.
 fn summarize_beside<T: Send>(
     design: &Design,
     job: &PrintJob,
     use_beside: bool,
     beside: impl FnOnce() -> T + Send,
-) -> (JobSummary, T) {
+) -> (JobSummary, f64, T) {
     let p = &design.printer;
     let tp = &job.toolpath;
     let moves = JobMoves::new(design, tp);
     let plan = motion::Plan::new(moves.home, &moves, p.max_acceleration, p.junction_deviation);
-    // The path's length (a pass over it) goes with the work beside.
-    let ((other, length), (time, volume)) = crate::parallel::both(
-        use_beside,
-        || (beside(), tp.length()),
-        || {
+    let path = moves.approach.len()..moves.approach.len() + moves.path.len();
+    let (other, (time, volume, (length, nominal_s))) =
+        crate::parallel::both(use_beside, beside, || {
             let volume: f64 = (1..tp.points.len())
                 .map(|i| segment_volume(design, tp, i))
                 .sum();
-            (plan.time(), volume)
-        },
-    );
+            // The planner's lengths are the path's segments (a plan without acceleration keeps none).
+            let sums = plan
+                .nominal(path)
+                .unwrap_or_else(|| (tp.length(), tp.print_time()));
+            (plan.time(), volume, sums)
+        });
     let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
     let summary = JobSummary {
         layers: job.surface.layers,
@@ -163,7 +166,7 @@ fn summarize_beside<T: Send>(
         volume_mm3: volume,
         e_length_mm: volume * p.flow_multiplier / feed_area,
     };
-    (summary, other)
+    (summary, nominal_s, other)
 }
 
 /// `1h 02m 03s` style duration.
@@ -356,14 +359,13 @@ fn write_program_indexed(
     let tp = &job.toolpath;
     // The thumbnails and the print time at nominal speeds (the body's progress is of it) are
     // worked out beside the motion planner's passes (the time estimate).
-    let (summary, (thumbnails, nominal_s)) = summarize_beside(design, job, true, || {
-        let thumbnails = p.thumbnail.then(|| {
+    let (summary, nominal_s, thumbnails) = summarize_beside(design, job, true, || {
+        p.thumbnail.then(|| {
             // Thinned to what a thumbnail draws: no copy of the whole path.
             let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
             let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
             crate::thumbnail::header_blocks(&points)
-        });
-        (thumbnails, tp.print_time())
+        })
     });
     let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
@@ -805,6 +807,26 @@ impl<'a> BodyWriter<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The path's length and its time at its own speeds, summed from the planner's moves, are
+    /// the toolpath's own sums to the last bit (a spiral whose speeds change: its upper layers
+    /// slowed to the minimum layer time).
+    #[test]
+    fn the_planners_sums_are_the_paths_own() {
+        let mut d = crate::load::parse_design(
+            "version = 1\n[shape]\nheight = 20.0\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 36.0 }\n[printer]\nmin_layer_time = 30.0\n",
+        )
+        .unwrap();
+        for a in [500.0, 5.0] {
+            d.printer.max_acceleration = a;
+            let job = crate::run(&d).unwrap();
+            let tp = &job.toolpath;
+            assert!(tp.points.windows(2).any(|w| w[0].speed != w[1].speed));
+            let (summary, nominal_s, ()) = summarize_beside(&d, &job, true, || ());
+            assert_eq!(summary.path_length_mm.to_bits(), tp.length().to_bits());
+            assert_eq!(nominal_s.to_bits(), tp.print_time().to_bits());
+        }
+    }
 
     /// The body written in rounds of chunks, on both cores, is the body formatted in one piece
     /// on one: a path of three chunks and more (two rounds, the last short), with progress,
