@@ -32,7 +32,8 @@ pub enum ExportError {
     Unreadable { file: String, error: GcodeError },
     /// The program breaks a limit of its printer: the worst-reported violation.
     #[error(
-        "does not print on this printer ({printer}): {what} at {count} points, worst {worst:.2} ({detail}); try a printer with a finer bead or thinner layers, or a simpler contour"
+        "does not print on this printer ({printer}): {what} at {count} points, worst {worst:.2} ({detail}); {}",
+        advice(what)
     )]
     Refused {
         printer: String,
@@ -41,6 +42,21 @@ pub enum ExportError {
         worst: f64,
         detail: String,
     },
+}
+
+/// What a potter can change when the self-check finds `what` broken. A vessel's path is one
+/// extruding spiral inside the machine by construction, so breaks of those rules come from the
+/// printer's start or end G-code; the others from the vessel on this printer.
+fn advice(what: &str) -> &'static str {
+    match what {
+        "not one continuous path" | "retraction" => {
+            "the printer's start or end G-code travels or retracts between extruding moves (a purge line?): leave that out of it"
+        }
+        "outside the machine" => {
+            "the printer's start or end G-code moves outside the machine, or the vessel does not fit it"
+        }
+        _ => "try a printer with a finer bead or thinner layers, or a simpler contour",
+    }
 }
 
 /// Writes the G-code of `job` (of `design`) to `path`, re-measured on its way when the design

@@ -680,19 +680,23 @@ mod tests {
         assert!(!g.exists());
     }
 
-    /// Right first time from the app as from the command line: the petal vase on the Potterbot
-    /// Baby has a layer too thick at 7 points of its program (which `clayloft gcode` refuses),
-    /// so "Export G-code" says what broke and writes nothing; the same vase on the default
-    /// printer is written.
+    /// Right first time from the app as from the command line: the petal vase with a start
+    /// G-code that lays a purge line and travels to the vessel is not one continuous path
+    /// (which `clayloft gcode` refuses), so "Export G-code" says what broke and writes nothing;
+    /// the same vase with the printer's own start G-code is written.
     #[test]
     fn a_program_past_its_printers_limits_is_not_exported() {
         let dir = tempfile::tempdir().unwrap();
         let bowl = design_path().with_file_name("petal-vase.toml");
-        let export = |printer: Option<&str>, name: &str| {
+        let export = |purge: bool, name: &str| {
             let mut app = app(dir.path());
-            let design = clayloft_core::load::load_design_using(&bowl, printer)
+            let mut design = clayloft_core::load::load_design_using(&bowl, None)
                 .unwrap()
                 .design;
+            if purge {
+                design.printer.start_gcode =
+                    Some("G28\nG1 X5 Y5 Z0.3 F3000\nG1 X60 Y5 Z5 E10 F1000\n".into());
+            }
             app.insert_resource(DesignDoc { design, path: None });
             app.update();
             let g = dir.path().join(name);
@@ -702,16 +706,17 @@ mod tests {
             finish_exports(&mut app);
             (app.world().resource::<FileStatus>().clone(), g)
         };
-        let (status, g) = export(Some("potterbot-baby"), "potterbot.gcode");
+        let (status, g) = export(true, "purged.gcode");
         let m = status.message.unwrap();
         assert!(status.is_error, "{m}");
         assert!(
             m.contains("not written")
-                && m.contains("does not print on this printer (potterbot-baby)"),
+                && m.contains("not one continuous path")
+                && m.contains("a purge line?"),
             "{m}"
         );
         assert!(!g.exists());
-        let (status, g) = export(None, "default.gcode");
+        let (status, g) = export(false, "default.gcode");
         assert!(!status.is_error, "{status:?}");
         assert!(g.exists());
         let left: Vec<_> = std::fs::read_dir(dir.path())

@@ -329,25 +329,33 @@ mod tests {
         assert!(s.check.is_none() && s.figures.is_some());
     }
 
-    /// The self-check's verdict is the export's: the petal vase on the Potterbot Baby (refused
-    /// by `clayloft gcode`: 5 mm beads where the tilted rim meets the rose's cusps, a layer too
-    /// thick at 7 points) does not pass, with the same words; on the default printer it does.
+    /// A start G-code that homes, lays a purge line beside the bed's corner and travels up and
+    /// away: the program is then not one continuous path (SPEC §2), which the self-check refuses.
+    const PURGE_LINE: &str = "G28\nG1 X5 Y5 Z0.3 F3000\nG1 X60 Y5 Z5 E10 F1000\n";
+
+    /// The self-check's verdict is the export's: the petal vase with a start G-code that lays a
+    /// purge line and travels to the vessel (refused by `clayloft gcode`: not one continuous
+    /// path) does not pass, with the same words; with the printer's own start G-code it does.
     #[test]
     fn the_program_check_is_the_exports() {
         let bowl = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../assets/designs/petal-vase.toml");
-        for (printer, passes) in [(Some("potterbot-baby"), false), (None, true)] {
-            let design = clayloft_core::load::load_design_using(&bowl, printer)
+        for (purge, passes) in [(true, false), (false, true)] {
+            let mut design = clayloft_core::load::load_design_using(&bowl, None)
                 .unwrap()
                 .design;
+            if purge {
+                design.printer.start_gcode = Some(PURGE_LINE.into());
+            }
             let job = clayloft_core::run(&design).unwrap();
             let mut c = PerJob::default();
             c.update(&7, || Some(check_program(design.clone(), job.clone())));
             let verdict = settle(&mut c, &7);
-            assert_eq!(verdict.is_ok(), passes, "{printer:?}: {verdict:?}");
+            assert_eq!(verdict.is_ok(), passes, "{purge}: {verdict:?}");
             if let Err(why) = verdict {
                 assert!(
-                    why.starts_with("does not print on this printer (potterbot-baby)"),
+                    why.starts_with("does not print on this printer (the paper's printer)")
+                        && why.contains("not one continuous path"),
                     "{why}"
                 );
                 let dir = tempfile::tempdir().unwrap();

@@ -71,13 +71,21 @@ impl ColumnChord {
     /// than √`short2` (see [`short_chord2`]), whose fraction single precision cannot place
     /// within 0.1.
     ///
+    /// Passes too chords with an end within √`end2` of `p` (see [`end_reach2`]): a point on
+    /// the bead's round end, past a sharp corner of the layer below (see
+    /// [`LayerSearch::past_corner`]).
+    ///
     /// And false when the chord lies wholly above or below the heights `z` (low, high) a layer
     /// under the point may have (the bead just laid, mostly).
-    fn may_be_under(&self, p: [f32; 2], z: [f32; 2], short2: f32) -> bool {
+    fn may_be_under(&self, p: [f32; 2], z: [f32; 2], [short2, end2]: [f32; 2]) -> bool {
         let ab = [self.b[0] - self.a[0], self.b[1] - self.a[1]];
         let len2 = ab[0] * ab[0] + ab[1] * ab[1];
         let dot = (p[0] - self.a[0]) * ab[0] + (p[1] - self.a[1]) * ab[1];
-        let beside = (len2 < short2) | ((dot >= -0.6 * len2) & (dot <= 1.6 * len2));
+        let dist2 = |q: [f32; 2]| (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]);
+        let beside = (len2 < short2)
+            | ((dot >= -0.6 * len2) & (dot <= 1.6 * len2))
+            | (dist2(self.a) <= end2)
+            | (dist2(self.b) <= end2);
         beside & (self.z_max >= z[0]) & (self.z_min <= z[1])
     }
 }
@@ -94,6 +102,15 @@ fn short_chord2(extent: f64, radius: f64) -> f32 {
     let delta = extent.abs() * 2f64.powi(-24);
     let len = (2.0 * (50.0 * delta + (20.0 * delta * radius).sqrt())).max(0.1);
     (len * len) as f32
+}
+
+/// The squared distance, mm², within which [`ColumnChord::may_be_under`] passes a chord whose
+/// end is that near the point, for coordinates up to `extent` mm: half a bead, and 8δ for the
+/// rounding of the coordinates to single precision (δ ≤ extent·2⁻²⁴ each) and of the sum.
+fn end_reach2(extent: f64, half_bead: f64) -> f32 {
+    let delta = extent.abs() * 2f64.powi(-24);
+    let r = half_bead * (1.0 + 1e-6) + 8.0 * delta + 1e-6;
+    (r * r) as f32
 }
 
 /// The chords that pass over one XY cell, in path order, with the running extremes of their
@@ -598,6 +615,7 @@ fn measure_layers_in(
         })
     });
     report.path_length_mm = cum[v.len() - 1];
+    let extent = limits.bed_x.max(limits.bed_y).max(limits.max_z) + margin;
     let search = LayerSearch {
         v,
         chords: &chords,
@@ -605,10 +623,10 @@ fn measure_layers_in(
         index: &index,
         radius,
         near_radius,
-        short2: short_chord2(
-            limits.bed_x.max(limits.bed_y).max(limits.max_z) + margin,
-            radius,
-        ),
+        prefilter: [
+            short_chord2(extent, radius),
+            end_reach2(extent, 0.5 * limits.line_width),
+        ],
         gap,
         stepped_up,
         below_tol,
@@ -957,8 +975,8 @@ struct LayerSearch<'a, F: Fn(DVec3) -> bool + Sync> {
     radius: f64,
     /// The first, smaller search box's half-width, mm (see [`LayerSearch::point`]).
     near_radius: f64,
-    /// See [`short_chord2`].
-    short2: f32,
+    /// The prefilter's two squared lengths, see [`short_chord2`] and [`end_reach2`].
+    prefilter: [f32; 2],
     gap: f64,
     /// A spot at least this far below the point (a minimum layer, less the tolerance) is a layer
     /// the path has stepped up from within a few beads (a base's next layer starting a layer up
@@ -1342,7 +1360,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
             for c in cell {
                 // Most candidates are rejected on their single-precision copy, without reading
                 // the path.
-                if !c.may_be_under(p32, z32, self.short2) {
+                if !c.may_be_under(p32, z32, self.prefilter) {
                     continue;
                 }
                 self.add_spot(j, c.id as usize, [z_lo, z_hi], &mut found);
@@ -1375,6 +1393,28 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         (self.inside)(a) && (self.inside)(b) && !steep(a, b)
     }
 
+    /// Whether `p`, at `f_line` along chord `id` (past one of its ends), lies past the end of
+    /// the chord on the other side of that end too: outside the tip of a sharp corner of the
+    /// path, which neither chord at the corner has beside it. There the corner is the spot
+    /// under p (within half a bead: on the bead's round end).
+    fn past_corner(&self, id: usize, f_line: f64, p: DVec2) -> bool {
+        let other = if f_line > 1.5 {
+            id.checked_add(1)
+        } else {
+            id.checked_sub(1)
+        };
+        let Some(&(ia, ib)) = other.and_then(|k| self.chords.get(k)) else {
+            return false;
+        };
+        let (a, b) = (self.v[ia].truncate(), self.v[ib].truncate());
+        let len2 = (b - a).length_squared();
+        if len2 == 0.0 {
+            return false;
+        }
+        let g = (p - a).dot(b - a) / len2;
+        if f_line > 1.5 { g < -0.5 } else { g > 1.5 }
+    }
+
     /// Adds to `found` the spot of chord `id` under point j, when it is one: the foot of the
     /// perpendicular on or near the chord, within `radius` across, at a height within `z`
     /// (low, high), and not on the bead just laid.
@@ -1394,11 +1434,11 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         } else {
             0.0
         };
-        if !(-0.5..=1.5).contains(&f_line) {
-            return;
-        }
         let (d, f) = point_segment_distance(pxy, a2, b2);
-        if d > self.radius {
+        if d > self.radius
+            || !((-0.5..=1.5).contains(&f_line)
+                || d <= self.half_bead && self.past_corner(id, f_line, pxy))
+        {
             return;
         }
         let zq = a.z + (b.z - a.z) * f;
@@ -1697,6 +1737,68 @@ mod tests {
         }
     }
 
+    /// A spiral of rhombi rising 0.5 mm a revolution (on a flat first one) and, from the third
+    /// on, moving out 0.15 mm a revolution (17°), with corners of 60° at their ends: each
+    /// corner's tip lies 0.3 mm past the one below, past the end of both 0.35 mm segments that meet there, which so have no
+    /// point beside it. The tip
+    /// below is what it rests on: the layers hold, leaning no more than the tips do (31°).
+    #[test]
+    fn a_sharp_corner_rests_on_the_corner_below() {
+        let limits = Limits::from(&Printer::default());
+        let (along, across) = (30.0, 30.0 * 30f64.to_radians().tan());
+        let corners = [
+            (along, 0.0),
+            (0.0, across),
+            (-along, 0.0),
+            (0.0, -across),
+            (along, 0.0),
+        ]
+        .map(|(x, y)| DVec2::new(x, y));
+        // One revolution: the rhombus's outline in steps of at most 0.35 mm, each point but the
+        // corners 10 µm to one side or the other (so that no chord stands for more than one
+        // segment, as on a curved wall).
+        let outline: Vec<DVec2> = corners
+            .windows(2)
+            .flat_map(|w| {
+                let steps = (w[0].distance(w[1]) / 0.35).ceil() as usize;
+                let side = (w[1] - w[0]).normalize().perp() * 0.01;
+                (0..steps).map(move |i| {
+                    let wobble = if i == 0 {
+                        0.0
+                    } else if i % 2 == 0 {
+                        1.0
+                    } else {
+                        -1.0
+                    };
+                    w[0].lerp(w[1], i as f64 / steps as f64) + side * wobble
+                })
+            })
+            .collect();
+        // The edges move out 0.15 mm a revolution: the rhombus scales about its inradius.
+        let inradius = along * across / (along * along + across * across).sqrt();
+        let per_rev = outline.len();
+        let v: Vec<DVec3> = (0..per_rev * 12)
+            .map(|i| {
+                let t = i as f64 / per_rev as f64;
+                let q = outline[i % per_rev] * (1.0 + 0.15 * (t - 2.0).max(0.0) / inradius);
+                // A flat first revolution, then the helix (leaving it by the thinnest layer).
+                let z = match t {
+                    t if t < 1.0 => 0.5,
+                    t if t < 2.0 => 0.75 + 0.25 * (t - 1.0),
+                    t => 0.5 + 0.5 * (t - 1.0),
+                };
+                DVec3::new(100.0 + q.x, 100.0 + q.y, z)
+            })
+            .collect();
+        let lines: Vec<usize> = (0..v.len()).collect();
+        let mut report = CheckReport::default();
+        measure_layers(&v, &lines, &limits, &mut report);
+        assert!(report.ok(), "{report}");
+        assert!(report.max_overhang_deg < 32.0, "{report}");
+        let mut quick = CheckReport::default();
+        assert!(layers_hold(&v, &lines, &limits, &mut quick));
+    }
+
     #[test]
     fn witnesses_do_not_show_a_lean_past_the_limit() {
         let limits = Limits::from(&Printer::default());
@@ -1813,8 +1915,31 @@ mod tests {
             prop_assume!((-0.5..=1.5).contains(&exact));
             let c = ColumnChord::new(0, 1, a, b);
             let z = [(az - 1.0) as f32, (az + 1.0) as f32];
-            let short2 = short_chord2(2000.0 + 2.0 * radius + 10.0, radius);
-            prop_assert!(c.may_be_under([p.x as f32, p.y as f32], z, short2));
+            let extent = 2000.0 + 2.0 * radius + 10.0;
+            let prefilter = [short_chord2(extent, radius), end_reach2(extent, 0.5 * radius)];
+            prop_assert!(c.may_be_under([p.x as f32, p.y as f32], z, prefilter));
+        }
+
+        /// Nor a chord with an end within half a bead of the point (up to the exact test's
+        /// last bit), wherever the point lies along it.
+        #[test]
+        fn prefilter_keeps_every_chord_with_an_end_within_half_a_bead(
+            ax in 0.0f64..2000.0, ay in 0.0f64..2000.0, az in 0.0f64..2000.0,
+            log_len in -2.0f64..1.3, angle in 0.0f64..std::f64::consts::TAU,
+            at_b in proptest::bool::ANY, away in 0.0f64..std::f64::consts::TAU,
+            reach in prop_oneof![Just(1.0), 0.0f64..=1.0], half_bead in 0.2f64..30.0,
+        ) {
+            let len = 10f64.powf(log_len);
+            let a = DVec3::new(ax, ay, az);
+            let b = a + (DVec2::from_angle(angle) * len).extend(0.3);
+            let end = if at_b { b } else { a }.truncate();
+            let p = end + DVec2::from_angle(away) * (reach * half_bead);
+            prop_assume!(p.distance(end) <= half_bead);
+            let c = ColumnChord::new(0, 1, a, b);
+            let z = [(az - 1.0) as f32, (az + 1.0) as f32];
+            let extent = 2000.0 + 4.0 * half_bead + 10.0;
+            let prefilter = [short_chord2(extent, 2.0 * half_bead), end_reach2(extent, half_bead)];
+            prop_assert!(c.may_be_under([p.x as f32, p.y as f32], z, prefilter));
         }
     }
 
