@@ -11,6 +11,7 @@ use std::time::Instant;
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use clayloft_model::DesignDoc;
+use clayloft_model::background::{Background, Stopped};
 use clayloft_replay::{Replay, ReplayPath};
 use clayloft_serial::line::strip;
 use clayloft_serial::link::{list_ports, open_port, run_job};
@@ -61,6 +62,10 @@ pub struct PrinterPanel {
     pub temperatures: Option<Temperatures>,
     pub messages: VecDeque<String>,
     pub status: Option<(String, bool)>,
+    /// A job being prepared on its own thread ([`prepare_job`]): the program written and
+    /// checked, the port opened. The window stays live meanwhile (the benchmark vase's program
+    /// takes about 60 ms to write and check).
+    pub preparing: Option<Background<Result<(Job, f64), String>>>,
 }
 
 pub struct PrinterPlugin;
@@ -78,6 +83,19 @@ impl Plugin for PrinterPlugin {
             draw_printer_window.in_set(clayloft_ui::UiSystems::Windows),
         );
     }
+}
+
+/// [`start_job`] with the job's planned printing time (the core's motion planner), s: what the
+/// panel runs on a thread of its own when "Print design" is pressed.
+pub fn prepare_job(
+    design: &clayloft_core::Design,
+    job: &clayloft_core::PrintJob,
+    port: &str,
+    baud: u32,
+) -> Result<(Job, f64), String> {
+    let started = start_job(design, job, port, baud)?;
+    let planned = clayloft_core::gcode::summarize(design, job).estimated_time_s;
+    Ok((started, planned))
 }
 
 /// Starts printing `job` (the session's, for `design`) on `port`: the core writes the program
@@ -149,7 +167,15 @@ fn pump_link_events(
     mut panel: ResMut<PrinterPanel>,
     mut replay: ResMut<Replay>,
     path: Res<ReplayPath>,
+    redraw: Option<ResMut<Messages<bevy::window::RequestRedraw>>>,
 ) {
+    // While a job is being prepared, frames are asked for so that it is polled (the app draws
+    // on input only).
+    if take_prepared_job(&mut panel)
+        && let Some(mut redraw) = redraw
+    {
+        redraw.write(bevy::window::RequestRedraw);
+    }
     let Some(job) = &panel.job else { return };
     let news: Vec<LinkEvent> = match job.events.lock() {
         Ok(rx) => rx.try_iter().collect(),
@@ -197,6 +223,33 @@ fn pump_link_events(
     }
 }
 
+/// Takes the job prepared on its thread, once it is: started, or why not. Whether one is still
+/// being prepared.
+fn take_prepared_job(panel: &mut PrinterPanel) -> bool {
+    let Some(preparing) = &mut panel.preparing else {
+        return false;
+    };
+    let Some(result) = preparing.poll() else {
+        return true;
+    };
+    panel.preparing = None;
+    match result {
+        Ok(Ok((job, planned))) => {
+            panel.planned_s = planned;
+            panel.recovered = 0;
+            panel.job = Some(job);
+            panel.done = 0;
+            panel.started = Some(Instant::now());
+            panel.status = Some((format!("printing on {}", panel.port), false));
+        }
+        Ok(Err(e)) => panel.status = Some((e, true)),
+        Err(Stopped) => {
+            panel.status = Some(("the program could not be prepared (stopped)".into(), true))
+        }
+    }
+    false
+}
+
 fn draw_printer_window(
     mut contexts: EguiContexts,
     mut panel: ResMut<PrinterPanel>,
@@ -232,26 +285,16 @@ fn draw_printer_window(
                 ui.label("Baud");
                 ui.add(egui::DragValue::new(&mut panel.baud).range(9600..=1_000_000));
             });
-            let running = panel.job.is_some();
+            let running = panel.job.is_some() || panel.preparing.is_some();
             ui.horizontal(|ui| {
                 if ui.add_enabled(!running && !panel.port.is_empty(), egui::Button::new("⏵ Print design")).clicked()
                     && let Some(doc) = &doc
                 {
-                    let planned = engine
-                        .current_job(&doc.design)
-                        .map(|job| clayloft_core::gcode::summarize(&doc.design, &job).estimated_time_s)
-                        .unwrap_or(0.0);
-                    let started = engine
-                        .current_job(&doc.design)
-                        .and_then(|job| start_job(&doc.design, &job, &panel.port.clone(), panel.baud));
-                    match started {
+                    match engine.current_job(&doc.design) {
                         Ok(job) => {
-                            panel.planned_s = planned;
-                            panel.recovered = 0;
-                            panel.job = Some(job);
-                            panel.done = 0;
-                            panel.started = Some(Instant::now());
-                            panel.status = Some((format!("printing on {}", panel.port), false));
+                            let (design, port, baud) = (doc.design.clone(), panel.port.clone(), panel.baud);
+                            panel.status = Some((format!("checking the program for this printer, then {port} …"), false));
+                            panel.preparing = Some(Background::start(move || prepare_job(&design, &job, &port, baud)));
                         }
                         Err(e) => panel.status = Some((e, true)),
                     }
@@ -347,25 +390,77 @@ mod tests {
         (name, fake)
     }
 
-    /// Right first time: the petal vase's program on the Potterbot Baby has a layer too thick
-    /// at 7 points (`clayloft gcode` refuses it), so printing it does not start, nor open the
-    /// port.
+    /// Right first time: the petal vase with a start G-code that lays a purge line and travels
+    /// to the vessel is not one continuous path (`clayloft gcode` refuses it), so printing it
+    /// does not start, nor open the port.
     #[test]
     fn a_program_past_the_printers_limits_is_not_started() {
         let bowl = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../assets/designs/petal-vase.toml");
-        let design = clayloft_core::load::load_design_using(&bowl, Some("potterbot-baby"))
+        let mut design = clayloft_core::load::load_design_using(&bowl, None)
             .unwrap()
             .design;
+        design.printer.start_gcode =
+            Some("G28\nG1 X5 Y5 Z0.3 F3000\nG1 X60 Y5 Z5 E10 F1000\n".into());
         let job = clayloft_core::run(&design).unwrap();
         let e = start_job(&design, &job, "/nonexistent/port", 115_200)
             .err()
             .expect("refused");
         assert!(
             e.starts_with(
-                "not printed: the design does not print on this printer (potterbot-baby)"
-            ),
+                "not printed: the design does not print on this printer (the paper's printer)"
+            ) && e.contains("not one continuous path"),
             "{e}"
+        );
+    }
+
+    /// "Print design" prepares the job on a thread of its own: the panel takes it once it is
+    /// ready (printing, with the planned time), or says why not (the port missing); until then
+    /// it has no job and says it is still preparing (so that frames are asked for).
+    #[test]
+    fn a_job_is_prepared_off_the_ui_thread_and_taken_when_ready() {
+        let design = clayloft_core::load::parse_design(
+            "version = 1\n[shape]\nheight = 5.0\nsamples = 24\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
+        )
+        .unwrap();
+        let print = clayloft_core::run(&design).unwrap();
+        let take = |port: String| {
+            let (d, p) = (design.clone(), print.clone());
+            let (gate_tx, gate) = std::sync::mpsc::channel::<()>();
+            let mut panel = PrinterPanel {
+                port: port.clone(),
+                preparing: Some(Background::start(move || {
+                    gate.recv().unwrap();
+                    prepare_job(&d, &p, &port, 115_200)
+                })),
+                ..PrinterPanel::default()
+            };
+            assert!(take_prepared_job(&mut panel), "still preparing");
+            assert!(panel.job.is_none());
+            gate_tx.send(()).unwrap();
+            while take_prepared_job(&mut panel) {
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+            assert!(panel.preparing.is_none());
+            panel
+        };
+        let (name, fake) = fake_printer();
+        let mut panel = take(name.clone());
+        assert_eq!(panel.status, Some((format!("printing on {name}"), false)));
+        assert!(panel.planned_s > 0.0);
+        let job = panel.job.take().expect("started");
+        let _ = job.control.send(Control::EmergencyStop);
+        drop(job);
+        drop(fake);
+        let panel = take("/nonexistent/port".into());
+        assert!(panel.job.is_none());
+        assert!(
+            panel
+                .status
+                .as_ref()
+                .is_some_and(|(m, error)| *error && m.contains("/nonexistent/port")),
+            "{:?}",
+            panel.status
         );
     }
 
