@@ -64,7 +64,7 @@ pub struct PrinterPanel {
     pub status: Option<(String, bool)>,
     /// A job being prepared on its own thread ([`prepare_job`]): the program written and
     /// checked, the port opened. The window stays live meanwhile (the benchmark vase's program
-    /// takes about 60 ms to write and check).
+    /// takes tens of milliseconds to write and check, a port may take longer to open).
     pub preparing: Option<Background<Result<(Job, f64), String>>>,
 }
 
