@@ -106,33 +106,44 @@ fn the_wall_leaves_the_base_on_every_printer_it_fits() {
         ("paper-woven", "wasp-40100-ldm"),
         ("flared-bowl", "potterbot-baby"),
     ] {
-        let out = dir.path().join(format!("{design}.{profile}.gcode"));
-        let run = clayloft(&[
-            "gcode",
-            &format!("assets/designs/{design}.toml"),
-            "--printer",
-            profile,
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        assert!(
-            run.status.success(),
-            "{design} on {profile}: {}",
-            text(&run.stderr)
-        );
+        let said = prints_and_checks(dir.path(), design, profile);
         // The oval jar's 0.5 mm layers are the delta's minimum: its wall cannot come back onto
         // them once it has left the base, and ends half a millimetre taller, as the summary says.
         if (design, profile) == ("ellipse-ripple", "klipper-paste-delta") {
-            let said = text(&run.stdout);
             assert!(
                 said.contains("x 70.5 mm wet")
                     && said.contains("the wall ends up to 0.50 mm above"),
                 "{said}"
             );
         }
-        let check = clayloft(&["check", out.to_str().unwrap()]);
-        assert_eq!(check.status.code(), Some(0), "{}", text(&check.stdout));
     }
+}
+
+/// `clayloft gcode` of shipped design `design` on shipped printer `profile` into `dir`: it
+/// prints, and `clayloft check` accepts the file. What the summary said.
+fn prints_and_checks(dir: &std::path::Path, design: &str, profile: &str) -> String {
+    let out = dir.join(format!("{design}.{profile}.gcode"));
+    let run = clayloft(&[
+        "gcode",
+        &format!("assets/designs/{design}.toml"),
+        "--printer",
+        profile,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{design} on {profile}: {}",
+        text(&run.stderr)
+    );
+    let check = clayloft(&["check", out.to_str().unwrap()]);
+    assert_eq!(
+        check.status.code(),
+        Some(0),
+        "{design} on {profile}: {}",
+        text(&check.stdout)
+    );
+    text(&run.stdout)
 }
 
 /// The petal vase on the printers of the widest beads: where the belly pushes the wall out of
@@ -145,18 +156,7 @@ fn the_wall_leaves_the_base_on_every_printer_it_fits() {
 fn a_wall_past_the_corners_of_the_layer_below_prints() {
     let dir = tempfile::tempdir().unwrap();
     for profile in ["potterbot-baby", "potterbot-super-10", "wasp-40100-ldm"] {
-        let out = dir.path().join(format!("{profile}.gcode"));
-        let run = clayloft(&[
-            "gcode",
-            "assets/designs/petal-vase.toml",
-            "--printer",
-            profile,
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        assert!(run.status.success(), "{profile}: {}", text(&run.stderr));
-        let check = clayloft(&["check", out.to_str().unwrap()]);
-        assert_eq!(check.status.code(), Some(0), "{}", text(&check.stdout));
+        prints_and_checks(dir.path(), "petal-vase", profile);
     }
 }
 

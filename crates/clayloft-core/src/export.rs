@@ -9,7 +9,9 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::atomic::{Replaced, WriteError};
-use crate::check::{CheckReport, GcodeError, GcodeVerifier, Limits};
+use crate::check::{
+    CheckReport, GcodeError, GcodeVerifier, Limits, NOT_CONTINUOUS, OUTSIDE, RETRACTION,
+};
 use crate::design::Design;
 use crate::gcode::{JobSummary, write_gcode_summarized};
 use crate::pipeline::PrintJob;
@@ -48,14 +50,12 @@ pub enum ExportError {
 /// extruding spiral inside the machine by construction, so breaks of those rules come from the
 /// printer's start or end G-code; the others from the vessel on this printer.
 fn advice(what: &str) -> &'static str {
-    match what {
-        "not one continuous path" | "retraction" => {
-            "the printer's start or end G-code travels or retracts between extruding moves (a purge line?): leave that out of it"
-        }
-        "outside the machine" => {
-            "the printer's start or end G-code moves outside the machine, or the vessel does not fit it"
-        }
-        _ => "try a printer with a finer bead or thinner layers, or a simpler contour",
+    if what == NOT_CONTINUOUS || what == RETRACTION {
+        "the printer's start or end G-code travels or retracts between extruding moves (a purge line?): leave that out of it"
+    } else if what == OUTSIDE {
+        "the printer's start or end G-code moves outside the machine, or the vessel does not fit it"
+    } else {
+        "try a printer with a finer bead or thinner layers, or a simpler contour"
     }
 }
 
@@ -152,6 +152,23 @@ impl Write for Tee<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A refusal says what a potter can change: the printer's G-code for a break of the one
+    /// path or of the machine's bounds (a vessel's path keeps those by construction), else the
+    /// printer or the contour.
+    #[test]
+    fn a_refusal_advises_by_what_broke() {
+        for what in [NOT_CONTINUOUS, RETRACTION, OUTSIDE] {
+            assert!(advice(what).contains("start or end G-code"), "{what}");
+        }
+        for what in [
+            crate::check::OVERHANG,
+            crate::check::UNSUPPORTED,
+            "layer too thin",
+        ] {
+            assert!(advice(what).contains("finer bead"), "{what}");
+        }
+    }
 
     fn vessel(extra: &str) -> (Design, PrintJob) {
         let d = crate::load::parse_design(&format!(

@@ -414,16 +414,22 @@ mod tests {
         );
     }
 
+    /// A cylinder 40 mm across, `height` mm tall, `samples` points a layer, and its job.
+    fn cylinder(height: f64, samples: usize) -> (clayloft_core::Design, clayloft_core::PrintJob) {
+        let design = clayloft_core::load::parse_design(&format!(
+            "version = 1\n[shape]\nheight = {height}\nsamples = {samples}\nlower = {{ type = \"circle\", radius = 20.0 }}\nupper = {{ type = \"circle\", radius = 20.0 }}\n"
+        ))
+        .unwrap();
+        let print = clayloft_core::run(&design).unwrap();
+        (design, print)
+    }
+
     /// "Print design" prepares the job on a thread of its own: the panel takes it once it is
     /// ready (printing, with the planned time), or says why not (the port missing); until then
     /// it has no job and says it is still preparing (so that frames are asked for).
     #[test]
     fn a_job_is_prepared_off_the_ui_thread_and_taken_when_ready() {
-        let design = clayloft_core::load::parse_design(
-            "version = 1\n[shape]\nheight = 5.0\nsamples = 24\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
-        )
-        .unwrap();
-        let print = clayloft_core::run(&design).unwrap();
+        let (design, print) = cylinder(5.0, 24);
         let take = |port: String| {
             let (d, p) = (design.clone(), print.clone());
             let (gate_tx, gate) = std::sync::mpsc::channel::<()>();
@@ -467,11 +473,7 @@ mod tests {
     #[test]
     fn a_job_streams_to_a_fake_printer_on_its_thread() {
         let (name, fake) = fake_printer();
-        let design = clayloft_core::load::parse_design(
-            "version = 1\n[shape]\nheight = 5.0\nsamples = 24\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
-        )
-        .unwrap();
-        let print = clayloft_core::run(&design).unwrap();
+        let (design, print) = cylinder(5.0, 24);
         let job = start_job(&design, &print, &name, 115_200).unwrap();
         // Every command carries its path point from the core's writer: in order, to the end.
         let points = job.point_of_command.clone();
@@ -507,11 +509,7 @@ mod tests {
     #[test]
     fn cancel_lifts_and_parks_on_the_fake_printer() {
         let (name, fake) = fake_printer();
-        let design = clayloft_core::load::parse_design(
-            "version = 1\n[shape]\nheight = 30.0\nsamples = 60\nlower = { type = \"circle\", radius = 20.0 }\nupper = { type = \"circle\", radius = 20.0 }\n",
-        )
-        .unwrap();
-        let print = clayloft_core::run(&design).unwrap();
+        let (design, print) = cylinder(30.0, 60);
         let job = start_job(&design, &print, &name, 115_200).unwrap();
         let rx = job.events.lock().unwrap();
         let mut cancelled = false;

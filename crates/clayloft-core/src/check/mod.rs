@@ -30,7 +30,8 @@ use moves::MoveReader;
 pub use moves::{GcodeError, Move, parse_moves};
 use report::Tally;
 pub use report::{
-    COLLISION, CheckReport, NOT_MEASURED, OVERHANG, PathEvent, UNSUPPORTED, Violation,
+    COLLISION, CheckReport, NOT_CONTINUOUS, NOT_MEASURED, OUTSIDE, OVERHANG, PathEvent, RETRACTION,
+    UNSUPPORTED, Violation,
 };
 
 /// Re-measures a G-code program against `limits`. Errors only when the text is not G-code.
@@ -252,7 +253,7 @@ fn tally_moves(
     report.violations.extend(
         [
             outside.into_violation(
-                "outside the machine",
+                OUTSIDE,
                 match limits.bed_shape {
                     crate::design::BedShape::Rectangle => format!(
                         "bed {} … {} × {} … {} mm, height 0 … {} mm",
@@ -265,10 +266,10 @@ fn tally_moves(
                 },
             ),
             travel.into_violation(
-                "not one continuous path",
+                NOT_CONTINUOUS,
                 "moves without extrusion between the first and last extruding move (worst = longest, mm)".into(),
             ),
-            retract.into_violation("retraction", "clay printing allows no retraction (worst = mm of E)".into()),
+            retract.into_violation(RETRACTION, "clay printing allows no retraction (worst = mm of E)".into()),
         ]
         .into_iter()
         .flatten(),

@@ -49,6 +49,13 @@ pub const OVERHANG: &str = "overhang";
 pub const UNSUPPORTED: &str = "unsupported";
 /// What a path the layer search could not measure within its budget is called in reports.
 pub const NOT_MEASURED: &str = "not measurable";
+/// What a point outside the bed or above the build height is called in reports.
+pub const OUTSIDE: &str = "outside the machine";
+/// What a move without extrusion between the first and last extruding move is called in
+/// reports.
+pub const NOT_CONTINUOUS: &str = "not one continuous path";
+/// What a move that draws the paste back is called in reports.
+pub const RETRACTION: &str = "retraction";
 
 impl CheckReport {
     pub fn ok(&self) -> bool {
