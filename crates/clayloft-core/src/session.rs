@@ -29,7 +29,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 use crate::design::{BedShape, ContourSpec, Design, HorizontalLine, Origin, Texture, VerticalLine};
 use crate::loft::{LoftInput, SampledContour, sample_contour};
@@ -566,6 +566,22 @@ impl Session {
             return self.mesh_wall.get()?.get(k);
         }
         self.sections.get(k)?.get().map(|s| &**s)
+    }
+
+    /// Vertical control line `l` drawn on the wall: the column at `angle_deg` of every shaped
+    /// section, so each vertex is the point the printer lays there (a fold trimmed out of a
+    /// section is trimmed out of the line too). Empty for a line the design does not have.
+    pub fn vertical_line_curve(&self, l: usize, angle_deg: f64) -> Vec<DVec3> {
+        let Some(model) = self.model() else {
+            return Vec::new();
+        };
+        if l >= model.vertical().len() || model.loft.samples() == 0 {
+            return Vec::new();
+        }
+        let i = model.column_at_angle(angle_deg.to_radians());
+        (0..self.sections.len())
+            .filter_map(|k| Some(self.shaped_section(k)?.points[i]))
+            .collect()
     }
 
     /// [`Session::shaped_section`], shared: a lofted design's sections are kept behind an `Arc`,
@@ -1175,5 +1191,44 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         let u = s.update(&d).unwrap();
         assert!(u.contours.is_empty() && !u.plan && u.sections.is_empty() && u.surface);
         assert!(s.is_current());
+    }
+
+    /// A vertical line's curve is its column of the shaped sections, exactly; on the shipped
+    /// petal vase (the app's first design), whose belly is pushed past the rose's cusps, those
+    /// sections have no fold left: no segment runs against its loft section's.
+    #[test]
+    fn a_vertical_line_is_drawn_on_its_column_of_the_folded_out_sections() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../assets/designs/petal-vase.toml");
+        let d = crate::load::load_design(&path).unwrap().design;
+        let mut s = Session::new();
+        s.update(&d).unwrap();
+        let model = s.model().unwrap().clone();
+        let angle = d.control.vertical[0].angle.unwrap_or(0.0);
+        let curve = s.vertical_line_curve(0, angle);
+        let i = model.column_at_angle(angle.to_radians());
+        assert_eq!(curve.len(), model.layers + 1);
+        let mut trimmed = 0;
+        for (k, p) in curve.iter().enumerate() {
+            let section = s.shaped_section(k).unwrap();
+            assert_eq!(*p, section.points[i]);
+            let t = k as f64 / model.layers as f64;
+            let loft: Vec<DVec2> = (0..model.loft.samples())
+                .map(|j| model.loft.point(j, t))
+                .collect();
+            let n = loft.len();
+            for j in 0..n {
+                let wall = section.points[(j + 1) % n].truncate() - section.points[j].truncate();
+                let along = loft[(j + 1) % n] - loft[j];
+                assert!(
+                    wall.dot(along) >= 0.0,
+                    "section {k} segment {j} runs backwards"
+                );
+                // A fold's columns spread over the short corner that cuts its tail off.
+                trimmed += usize::from(wall.length() < 0.1 * along.length());
+            }
+        }
+        assert!(trimmed > 100, "only {trimmed} columns on a fold's corner");
+        assert!(s.vertical_line_curve(1, angle).is_empty());
     }
 }

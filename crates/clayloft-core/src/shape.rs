@@ -5,13 +5,19 @@
 //! `P(i, t) + d(i, t)·nᵢ` in XY, with d the sum of the vertical control lines, and
 //! `z = k·h + s·Σ_l w_l(t)·dz_l(φᵢ)` with h = height / L and s the horizontal-line scale (1 unless
 //! a constraint needed it lowered). Section 0 is the bed contact at z = 0.
+//!
+//! Where a concave stretch is pushed out further than its radius of curvature (d > ρ, a belly
+//! past a rose's cusps), `P + d·n` folds back on itself in a swallowtail; the wall there is the
+//! offset's corner, the crossing of the two sides, and the tail's points are spread over that
+//! corner ([`trim_swallowtails`]). The nozzle then turns the corner instead of tracing a loop
+//! of clay, and the texture fades over the squeezed columns (`texture::squeeze_fade`).
 
 use glam::{DVec2, DVec3};
 
 use crate::control::angle_difference;
 use crate::control::{HorizontalProfile, VerticalProfile};
 use crate::design::{Design, VerticalLine};
-use crate::geometry::{outward_normal_at, outward_normals};
+use crate::geometry::{outward_normal_at, outward_normals, trim_swallowtails};
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind};
 use crate::section::Section;
@@ -22,6 +28,14 @@ use crate::validate::{FieldError, MAX_PATH_POINTS};
 pub const LIMIT_MARGIN: f64 = 0.98;
 /// Height-fraction resolution used to plan layers against horizontal control lines.
 const PLAN_STEPS: usize = 512;
+
+/// Samples on either side of a fold within which its crossing is searched
+/// ([`trim_swallowtails`]): a twelfth of the ring (60 of 720 samples, 30° of a round vessel),
+/// far more than the folds of a belly pushed past a rose's cusps (about 25 samples a side on
+/// the benchmark vase); a fold wider than that is left for the checker to find.
+fn swallowtail_reach(samples: usize) -> usize {
+    (samples / 12).max(8)
+}
 
 /// Everything needed to compute any section of the shaped (uncorrected, untextured) surface.
 #[derive(Debug, Clone)]
@@ -141,20 +155,20 @@ impl ShapeModel {
         let n = self.loft.samples();
         let xy: Vec<DVec2> = (0..n).map(|i| self.loft.point(i, t)).collect();
         let active = self.active_vertical(t, None);
-        let normals = if active.is_empty() {
-            Vec::new()
-        } else {
-            outward_normals(&xy)
-        };
-        let points = (0..n)
-            .map(|i| {
-                let mut p = xy[i];
+        let mut wall = xy.clone();
+        if !active.is_empty() {
+            let normals = outward_normals(&xy);
+            for (i, p) in wall.iter_mut().enumerate() {
                 for (l, d) in &active {
-                    p += normals[i] * (d * self.weights[*l][i]);
+                    *p += normals[i] * (d * self.weights[*l][i]);
                 }
-                let z = z0.map_or(0.0, |z0| z0 + self.dz(i, t));
-                DVec3::new(p.x, p.y, z)
-            })
+            }
+            trim_swallowtails(&mut wall, &xy, swallowtail_reach(n));
+        }
+        let points = wall
+            .iter()
+            .enumerate()
+            .map(|(i, p)| DVec3::new(p.x, p.y, z0.map_or(0.0, |z0| z0 + self.dz(i, t))))
             .collect();
         Section { points }
     }
@@ -205,36 +219,27 @@ impl ShapeModel {
             .map(|&j| self.loft.point(j, t))
             .collect();
         let normal = outward_normal_at(&xy, 1);
-        let mut base = xy[1];
-        for (l, d) in self.active_vertical(t, line) {
-            base += normal * (d * self.weights[l][i]);
-        }
-        let z = z0.map_or(0.0, |z0| z0 + self.dz(i, t));
         let dir = line
             .and_then(|l| self.weights.get(l))
             .map_or(DVec2::ZERO, |w| normal * w[i]);
-        (base.extend(z), dir)
+        let active = self.active_vertical(t, None);
+        if active.is_empty() {
+            let z = z0.map_or(0.0, |z0| z0 + self.dz(i, t));
+            return (xy[1].extend(z), dir);
+        }
+        // Pushed out, the wall may fold back on itself here, which only the whole section
+        // shows (`trim_swallowtails`): the point is the section's, and the base is that point
+        // less the line's own push.
+        let wall = self.shaped_section(t, z0).points[i];
+        let own = line
+            .and_then(|l| active.iter().find(|(k, _)| *k == l))
+            .map_or(0.0, |(_, d)| *d);
+        (wall - (dir * own).extend(0.0), dir)
     }
 
     /// The shaped wall point of column i at height fraction t.
     pub fn wall_point(&self, i: usize, t: f64) -> DVec3 {
         self.wall_frame(i, t, None).0
-    }
-
-    /// Vertical control line l drawn on the wall: its column at every section height, so each
-    /// vertex is the point of the section the printer lays there.
-    pub fn vertical_line_curve(&self, l: usize, angle_deg: f64) -> Vec<DVec3> {
-        if l >= self.vertical.len() || self.loft.samples() == 0 {
-            return Vec::new();
-        }
-        let i = self.column_at_angle(angle_deg.to_radians());
-        (0..=self.layers)
-            .map(|k| {
-                let t = k as f64 / self.layers as f64;
-                self.frame_at(i, t, (k > 0).then_some(k as f64 * self.layer_pitch), None)
-                    .0
-            })
-            .collect()
     }
 
     /// A horizontal control line drawn on the wall at its height fraction `at`, closed.
@@ -536,13 +541,6 @@ mod wall_tests {
                     s.points[i]
                 );
             }
-        }
-        // The vertical line's curve is its column of the sections, exactly.
-        let curve = m.vertical_line_curve(1, 30.0);
-        let i = m.column_at_angle(30f64.to_radians());
-        assert_eq!(curve.len(), m.layers + 1);
-        for (k, p) in curve.iter().enumerate() {
-            assert_eq!(*p, m.section(k).points[i]);
         }
     }
 

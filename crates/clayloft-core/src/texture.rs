@@ -106,6 +106,8 @@ pub fn apply_displacements(
         return Vec::new();
     }
     let parts = crate::parallel::ranges(n, 128);
+    let typical: Vec<f64> = sections.iter().map(typical_chord).collect();
+    let typical = &typical;
     // The columns just outside each part, as they are before the texture.
     let column = |i: usize| -> Vec<glam::DVec2> {
         sections.iter().map(|s| s.points[i].truncate()).collect()
@@ -131,19 +133,74 @@ pub fn apply_displacements(
     let mut events = Vec::new();
     if work.len() == 1 {
         for ((cols, part), (left, right)) in work {
-            events = texture_columns(cols, part, &left, &right, disp, tan_limit, enforce);
+            events = texture_columns(
+                cols,
+                part,
+                (&left, &right),
+                typical,
+                disp,
+                tan_limit,
+                enforce,
+            );
         }
         return events;
     }
     for part in crate::parallel::run_parts(
         work.map(|((cols, part), (left, right))| {
-            move || texture_columns(cols, part, &left, &right, disp, tan_limit, enforce)
+            move || {
+                texture_columns(
+                    cols,
+                    part,
+                    (&left, &right),
+                    typical,
+                    disp,
+                    tan_limit,
+                    enforce,
+                )
+            }
         })
         .collect(),
     ) {
         events.extend(part);
     }
     events
+}
+
+/// Columns closer together than this share of their section's typical spacing are squeezed
+/// (see [`squeeze_fade`]). A loft's own spacing varies far less: 0.67–1.87 of the typical on
+/// the shipped designs' shaped sections outside their folds; a fold's tail spread over its
+/// corner comes down to a thousandth of it (measured 2026-12-05).
+const SQUEEZE: f64 = 0.25;
+
+/// The share (0 … 1) of the texture a point takes whose neighbours lie `before` and `after` it
+/// on a section of typical chord `typical` ([`typical_chord`]): all of it, but where the
+/// columns are squeezed together below [`SQUEEZE`] (a concave stretch pushed past its radius of
+/// curvature, its fold cut off by the shape, `geometry::trim_swallowtails`), in proportion to
+/// the squeeze. The wave there is compressed along the wall; fading it with the squeeze keeps its
+/// slope within 1 / SQUEEZE of the design's instead of zig-zagging across the corner.
+#[inline]
+fn squeeze_fade(before: glam::DVec2, after: glam::DVec2, typical: f64) -> f64 {
+    let threshold = SQUEEZE * typical;
+    let chord2 = (after - before).length_squared();
+    if chord2 >= threshold * threshold {
+        1.0
+    } else {
+        chord2.sqrt() / threshold
+    }
+}
+
+/// The typical chord `|pᵢ₊₁ − pᵢ₋₁|` of a section: twice its length over its point count, the
+/// length measured on every `n / 64`-th point (a fold's corner is short either way).
+fn typical_chord(section: &crate::section::Section) -> f64 {
+    let p = &section.points;
+    let n = p.len();
+    if n < 3 {
+        // No ring to squeeze: a threshold of nothing fades nothing.
+        return 0.0;
+    }
+    let step = (n / 64).max(1);
+    let ring: Vec<glam::DVec2> = p.iter().step_by(step).map(|q| q.truncate()).collect();
+    2.0 * crate::geometry::closed_length(&ring) / n as f64
 }
 
 /// The largest share (0 … 1) of the texture a column may take at the point `above` over `below`
@@ -170,21 +227,24 @@ fn admissible_scale(
 }
 
 /// [`apply_displacements`] on the columns `cols` (`part[k]`: section k's points there; `left`,
-/// `right`: each section's point just before and after them): the normals before the texture,
-/// the largest admissible scale of each column and the layer where it binds, the shifts; the
-/// columns scaled down, in order.
+/// `right`: each section's point just before and after them; `typical`: each section's typical
+/// chord): the normals before the texture and the displacements faded where the columns are
+/// squeezed, the largest admissible scale of each column and the layer where it binds, the
+/// shifts; the columns scaled down, in order.
 fn texture_columns(
     cols: std::ops::Range<usize>,
     mut part: Vec<&mut [glam::DVec3]>,
-    left: &[glam::DVec2],
-    right: &[glam::DVec2],
+    (left, right): (&[glam::DVec2], &[glam::DVec2]),
+    typical: &[f64],
     disp: &[Vec<f64>],
     tan_limit: f64,
     enforce: bool,
 ) -> Vec<crate::report::PointEvent> {
     let (w, count) = (cols.len(), part.len());
-    // Outward normals in XY, section-major, as `Section::normals` has them.
+    // Outward normals in XY, section-major, as `Section::normals` has them, and each point's
+    // displacement faded by its squeeze.
     let mut normals = Vec::with_capacity(count * w);
+    let mut shifts = Vec::with_capacity(count * w);
     for (k, row) in part.iter().enumerate() {
         for c in 0..w {
             let before = if c == 0 {
@@ -198,17 +258,18 @@ fn texture_columns(
                 row[c + 1].truncate()
             };
             normals.push(crate::geometry::normal_from_neighbours(before, after));
+            shifts.push(disp[k][cols.start + c] * squeeze_fade(before, after, typical[k]));
         }
     }
     // Largest admissible scale per column, and the layer where it binds.
     let mut scale = vec![(1.0_f64, 0_usize); w];
     for k in 1..count {
         let (above, below) = (&part[k], &part[k - 1]);
-        for (c, i) in cols.clone().enumerate() {
+        for c in 0..w {
             let allowed = admissible_scale(
                 (above[c], below[c]),
                 (normals[k * w + c], normals[(k - 1) * w + c]),
-                (disp[k][i], disp[k - 1][i]),
+                (shifts[k * w + c], shifts[(k - 1) * w + c]),
                 tan_limit,
             );
             if allowed < scale[c].0 {
@@ -231,7 +292,7 @@ fn texture_columns(
     for (k, row) in part.iter_mut().enumerate() {
         for (c, p) in row.iter_mut().enumerate() {
             let s = if enforce { scale[c].0 } else { 1.0 };
-            let shift = normals[k * w + c] * (disp[k][cols.start + c] * s);
+            let shift = normals[k * w + c] * (shifts[k * w + c] * s);
             p.x += shift.x;
             p.y += shift.y;
         }
@@ -252,13 +313,27 @@ mod tests {
     ) -> Vec<(usize, usize, u64)> {
         let n = sections[0].points.len();
         let normals: Vec<Vec<glam::DVec2>> = sections.iter().map(|s| s.normals()).collect();
+        let shifts: Vec<Vec<f64>> = sections
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                let typical = typical_chord(s);
+                (0..n)
+                    .map(|i| {
+                        let (b, a) = crate::geometry::ring_neighbours(i, n);
+                        let (b, a) = (s.points[b].truncate(), s.points[a].truncate());
+                        disp[k][i] * squeeze_fade(b, a, typical)
+                    })
+                    .collect()
+            })
+            .collect();
         let mut scale = vec![(1.0_f64, 0_usize); n];
         for k in 1..sections.len() {
             for i in 0..n {
                 let allowed = admissible_scale(
                     (sections[k].points[i], sections[k - 1].points[i]),
                     (normals[k][i], normals[k - 1][i]),
-                    (disp[k][i], disp[k - 1][i]),
+                    (shifts[k][i], shifts[k - 1][i]),
                     tan_limit,
                 );
                 if allowed < scale[i].0 {
@@ -276,7 +351,7 @@ mod tests {
         for (k, section) in sections.iter_mut().enumerate() {
             for (i, p) in section.points.iter_mut().enumerate() {
                 let s = if enforce { scale[i].0 } else { 1.0 };
-                let shift = normals[k][i] * (disp[k][i] * s);
+                let shift = normals[k][i] * (shifts[k][i] * s);
                 p.x += shift.x;
                 p.y += shift.y;
             }
@@ -294,7 +369,17 @@ mod tests {
                     .map(|k| crate::section::Section {
                         points: (0..n)
                             .map(|i| {
-                                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                                // A tenth of the columns squeezed into a hundredth of the ring,
+                                // as a fold's are: their texture fades.
+                                let (from, to) = (n / 3, n / 3 + n / 10);
+                                let at = if (from..to).contains(&i) {
+                                    from as f64 + 0.1 * (i - from) as f64
+                                } else if i >= to {
+                                    i as f64 - 0.9 * (to - from) as f64
+                                } else {
+                                    i as f64
+                                };
+                                let a = std::f64::consts::TAU * at / n as f64;
                                 let r = 30.0 + 0.3 * k as f64 + 2.0 * (5.0 * a).sin();
                                 glam::DVec3::new(r * a.cos(), r * a.sin(), 0.5 * k as f64)
                             })
@@ -330,6 +415,48 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// Where a tenth of a ring's columns are squeezed into a hundredth of it (chords about a
+    /// tenth of the typical), they take about 0.1 / SQUEEZE = 0.4 of the texture; the rest all
+    /// of it.
+    #[test]
+    fn a_squeezed_stretch_takes_its_texture_in_proportion() {
+        let n = 360;
+        let at = |i: usize| {
+            let (from, to) = (100, 136);
+            if (from..to).contains(&i) {
+                from as f64 + 0.1 * (i - from) as f64
+            } else if i >= to {
+                i as f64 - 0.9 * (to - from) as f64
+            } else {
+                i as f64
+            }
+        };
+        let ring = |z: f64| crate::section::Section {
+            points: (0..n)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * at(i) / (n as f64 - 32.4);
+                    glam::DVec3::new(30.0 * a.cos(), 30.0 * a.sin(), z)
+                })
+                .collect(),
+        };
+        let before = vec![ring(0.0), ring(0.5)];
+        let mut after = before.clone();
+        let events = apply_displacements(&mut after, &vec![vec![1.0; n]; 2], 1e9, true);
+        assert!(events.is_empty());
+        for i in 0..n {
+            let moved = after[1].points[i].distance(before[1].points[i]);
+            // The squeezed chords against the typical (the ring's mean, a little longer than
+            // the unsqueezed ones' spacing over the whole ring): 0.1 · 360 / 327.6.
+            let squeezed = 0.1 * n as f64 / (n as f64 - 32.4);
+            let expected = if (101..=135).contains(&i) {
+                squeezed / SQUEEZE
+            } else {
+                1.0
+            };
+            assert!((moved - expected).abs() < 0.02, "column {i}: moved {moved}");
         }
     }
 

@@ -201,13 +201,17 @@ pub fn derive_control_lines(
     };
     let curve = |line: ControlLine| -> Vec<DVec3> {
         match line.kind {
-            LineKind::Vertical => design
-                .control
-                .vertical
-                .get(line.index)
-                .map_or_else(Vec::new, |v| {
-                    model.vertical_line_curve(line.index, v.angle.unwrap_or(0.0))
-                }),
+            LineKind::Vertical => {
+                design
+                    .control
+                    .vertical
+                    .get(line.index)
+                    .map_or_else(Vec::new, |v| {
+                        engine
+                            .0
+                            .vertical_line_curve(line.index, v.angle.unwrap_or(0.0))
+                    })
+            }
             LineKind::Horizontal => design
                 .control
                 .horizontal
