@@ -575,3 +575,47 @@ mod tests {
         assert_eq!(dedup_closed(&pts).len(), 3);
     }
 }
+
+#[cfg(test)]
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// On any ring pushed any way from any reference (jagged, with repeated points),
+        /// trimming keeps the point count, moves no more than it has, and only ever moves a
+        /// point onto the ring as given (a fold's corner lies on its two sides).
+        #[test]
+        fn trimming_keeps_the_count_and_stays_on_the_ring(
+            radii in proptest::collection::vec(5.0..50.0f64, 4..150),
+            push in -30.0..30.0f64,
+            reach in 1usize..40,
+            repeat in 0usize..150,
+        ) {
+            let n = radii.len();
+            let mut reference: Vec<DVec2> = radii
+                .iter()
+                .enumerate()
+                .map(|(i, r)| DVec2::from_angle(std::f64::consts::TAU * i as f64 / n as f64) * *r)
+                .collect();
+            reference[repeat % n] = reference[(repeat + 1) % n];
+            let given: Vec<DVec2> = reference
+                .iter()
+                .zip(outward_normals(&reference))
+                .map(|(p, nrm)| *p + nrm * push)
+                .collect();
+            let mut wall = given.clone();
+            let moved = trim_swallowtails(&mut wall, &reference, reach);
+            prop_assert_eq!(wall.len(), n);
+            prop_assert!(moved <= n);
+            for p in &wall {
+                let d = (0..n)
+                    .map(|j| point_segment_distance(*p, given[j], given[(j + 1) % n]).0)
+                    .fold(f64::INFINITY, f64::min);
+                prop_assert!(d < 1e-6, "{} off the ring", d);
+            }
+        }
+    }
+}
