@@ -263,7 +263,7 @@ fn crossing_point(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> DVec2 {
 /// A concave stretch pushed outward further than its radius of curvature (an offset `d > ρ`)
 /// turns back on itself: its segments run against the reference's, between two cusps, and the
 /// stretches before and after cross (a swallowtail). The wall there is a corner at the
-/// crossing: the tail's points are spread over it ([`spread_over_corner`]), so the ring keeps
+/// crossing: the tail's points are spread over it, in order and apart, so the ring keeps
 /// its point count (one point per column) and the nozzle turns the corner once instead of
 /// tracing the loop.
 ///

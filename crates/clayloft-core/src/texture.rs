@@ -130,37 +130,26 @@ pub fn apply_displacements(
         }
     }
     let work = parts.into_iter().zip(columns).zip(edges);
+    // One part's work (a copy of it for each part: it holds only references).
+    let part_work = move |((cols, part), (left, right)): ((_, _), (Vec<_>, Vec<_>))| {
+        texture_columns(
+            cols,
+            part,
+            (&left, &right),
+            typical,
+            disp,
+            tan_limit,
+            enforce,
+        )
+    };
     let mut events = Vec::new();
     if work.len() == 1 {
-        for ((cols, part), (left, right)) in work {
-            events = texture_columns(
-                cols,
-                part,
-                (&left, &right),
-                typical,
-                disp,
-                tan_limit,
-                enforce,
-            );
+        for item in work {
+            events = part_work(item);
         }
         return events;
     }
-    for part in crate::parallel::run_parts(
-        work.map(|((cols, part), (left, right))| {
-            move || {
-                texture_columns(
-                    cols,
-                    part,
-                    (&left, &right),
-                    typical,
-                    disp,
-                    tan_limit,
-                    enforce,
-                )
-            }
-        })
-        .collect(),
-    ) {
+    for part in crate::parallel::run_parts(work.map(|item| move || part_work(item)).collect()) {
         events.extend(part);
     }
     events
