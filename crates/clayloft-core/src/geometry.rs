@@ -258,7 +258,8 @@ fn crossing_point(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> DVec2 {
 }
 
 /// Folds the swallowtails out of a closed polyline moved point by point from `reference` (the
-/// same number of points, the same order), in place; returns how many points it moved.
+/// same number of points, the same order), in place; returns how many points it moved and the
+/// farthest it moved one.
 ///
 /// A concave stretch pushed outward further than its radius of curvature (an offset `d > ρ`)
 /// turns back on itself: its segments run against the reference's, between two cusps, and the
@@ -272,24 +273,24 @@ fn crossing_point(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> DVec2 {
 /// one whose sides do not cross within reach, is left as it is. The search tests at most
 /// [`TRIM_TESTS_PER_POINT`] pairs of segments per point of the ring, whatever the ring: runs
 /// past that budget are left as they are too (for the checker to judge).
-pub fn trim_swallowtails(points: &mut [DVec2], reference: &[DVec2], reach: usize) -> usize {
+pub fn trim_swallowtails(points: &mut [DVec2], reference: &[DVec2], reach: usize) -> (usize, f64) {
     let n = points.len();
     if n < 4 || reference.len() != n || reach == 0 {
-        return 0;
+        return (0, 0.0);
     }
     let next = |i: usize| if i + 1 == n { 0 } else { i + 1 };
     let reversed =
         |p: &[DVec2], j: usize| (p[next(j)] - p[j]).dot(reference[next(j)] - reference[j]) < 0.0;
     if !(0..n).any(|j| reversed(points, j)) {
-        return 0;
+        return (0, 0.0);
     }
     // The first segment that is not reversed: runs are found from there on, so none wraps past
     // the start of the search.
     let Some(first) = (0..n).find(|&j| !reversed(points, j)) else {
-        return 0;
+        return (0, 0.0);
     };
     let given = points.to_vec();
-    let mut moved = 0;
+    let mut trimmed = false;
     let mut budget = TRIM_TESTS_PER_POINT * n;
     let mut s = 0;
     while s < n && budget > 0 {
@@ -327,30 +328,33 @@ pub fn trim_swallowtails(points: &mut [DVec2], reference: &[DVec2], reach: usize
             }
         }
         if let Some((j, k, x)) = crossing {
-            moved += spread_over_corner(points, &given, j, k, x);
+            spread_over_corner(points, &given, j, k, x);
+            trimmed = true;
         }
     }
-    moved
+    if !trimmed {
+        return (0, 0.0);
+    }
+    // Counted at the end: folds close together may move the same point twice.
+    points
+        .iter()
+        .zip(&given)
+        .map(|(p, q)| p.distance(*q))
+        .filter(|&d| d > 0.0)
+        .fold((0, 0.0), |(count, most), d| (count + 1, d.max(most)))
 }
 
 /// Puts points `j + 1 ..= k` (of a ring, wrapping) on the corner `pⱼ → x → pₖ₊₁` that cuts off
-/// their tail, evenly by length and in order, the one nearest the corner on it; returns how
-/// many were moved. Kept apart (none on `pⱼ`, `pₖ₊₁` or another), every point keeps a
+/// their tail, evenly by length and in order, the one nearest the corner on it. Kept apart (none on `pⱼ`, `pₖ₊₁` or another), every point keeps a
 /// direction to its neighbours, so normals, offsets and the toolpath see a corner, not a stack
 /// of coincident points. A corner of no length is left alone.
-fn spread_over_corner(
-    points: &mut [DVec2],
-    given: &[DVec2],
-    j: usize,
-    k: usize,
-    x: DVec2,
-) -> usize {
+fn spread_over_corner(points: &mut [DVec2], given: &[DVec2], j: usize, k: usize, x: DVec2) {
     let n = points.len();
     let (start, end) = (given[j], given[(k + 1) % n]);
     let (to_x, from_x) = (start.distance(x), x.distance(end));
     let length = to_x + from_x;
     if length <= POINT_EPS {
-        return 0;
+        return;
     }
     let count = (k + n - j) % n;
     let step = length / (count + 1) as f64;
@@ -367,7 +371,6 @@ fn spread_over_corner(
             x.lerp(end, (s - to_x) / from_x)
         };
     }
-    count
 }
 
 /// Distance from `p` to segment `a–b`, and the parameter `f ∈ [0, 1]` of the closest point.
@@ -516,8 +519,10 @@ mod tests {
             .map(|p| distance_to(*p, &reference))
             .fold(f64::INFINITY, f64::min);
         assert!(closest < 11.0, "closest {closest}");
-        let moved = trim_swallowtails(&mut wall, &reference, 32);
+        let (moved, most) = trim_swallowtails(&mut wall, &reference, 32);
         assert!(moved > folded, "{moved} points moved");
+        // The tails reached to 7.9 mm from the rose: moved out to 12 mm and along the wall.
+        assert!(most > 4.0 && most < 30.0, "moved up to {most} mm");
         assert_eq!(wall.len(), 720);
         assert_eq!(reversed_segments(&wall, &reference), 0);
         assert_eq!(find_self_intersection(&wall), None);
@@ -552,12 +557,12 @@ mod tests {
             };
             let mut wall = pushed(&ring, d);
             let before = wall.clone();
-            assert_eq!(trim_swallowtails(&mut wall, &reference, 32), 0);
+            assert_eq!(trim_swallowtails(&mut wall, &reference, 32), (0, 0.0));
             assert_eq!(wall, before);
         }
         let mut wall = pushed(&reference, 12.0);
         let before = wall.clone();
-        assert_eq!(trim_swallowtails(&mut wall, &reference, 1), 0);
+        assert_eq!(trim_swallowtails(&mut wall, &reference, 1), (0, 0.0));
         assert_eq!(wall, before);
     }
 
@@ -607,9 +612,12 @@ mod properties {
                 .map(|(p, nrm)| *p + nrm * push)
                 .collect();
             let mut wall = given.clone();
-            let moved = trim_swallowtails(&mut wall, &reference, reach);
+            let (moved, most) = trim_swallowtails(&mut wall, &reference, reach);
             prop_assert_eq!(wall.len(), n);
             prop_assert!(moved <= n);
+            let changed = wall.iter().zip(&given).filter(|(a, b)| a != b).count();
+            let farthest = wall.iter().zip(&given).map(|(a, b)| a.distance(*b)).fold(0.0, f64::max);
+            prop_assert_eq!((moved, most), (changed, farthest));
             for p in &wall {
                 let d = (0..n)
                     .map(|j| point_segment_distance(*p, given[j], given[(j + 1) % n]).0)

@@ -16,6 +16,9 @@ pub enum FindingKind {
     Base,
     /// The wall's layers where the spiral leaves the flat layer (the path ahead of the design).
     Layers,
+    /// Vertical control lines pushing a concave stretch out past its curvature: the wall's
+    /// folds cut off at their corners (`geometry::trim_swallowtails`).
+    Folds,
 }
 
 /// One correction or violation, over a range of layers.

@@ -285,6 +285,8 @@ pub struct Session {
     contours: [Stage<ContourKey, SampledContour>; 2],
     plan: Stage<PlanKey, (ShapeModel, Vec<Finding>)>,
     sections: Vec<Stage<SectionKey, Arc<Section>>>,
+    /// What cutting off each shaped section's folds did, beside `sections`.
+    section_folds: Vec<crate::shape::Folds>,
     /// Bumped whenever any section is recomputed or the section count changes.
     sections_revision: u64,
     /// The stages after the shape, lofted or sliced: texture, surface, base, beads, toolpath,
@@ -415,6 +417,7 @@ impl Session {
         let count = model.layers + 1;
         if self.sections.len() != count {
             self.sections.resize_with(count, Stage::default);
+            self.section_folds.resize(count, Default::default());
             self.sections_revision += 1;
         }
         let mut dirty = Vec::new();
@@ -440,8 +443,9 @@ impl Session {
         }
         if !dirty.is_empty() {
             let shaped = shape_sections(model, &dirty);
-            for (&k, section) in dirty.iter().zip(shaped) {
+            for (&k, (section, folds)) in dirty.iter().zip(shaped) {
                 self.sections[k].value = Some(Arc::new(section));
+                self.section_folds[k] = folds;
             }
             self.sections_revision += 1;
         }
@@ -454,6 +458,8 @@ impl Session {
         };
         let (sections, one_update) = (&mut self.sections, self.one_update);
         let surface_inputs = (plan_revision, self.sections_revision);
+        let mut findings = plan_findings.clone();
+        findings.extend(crate::shape::fold_findings(&self.section_folds));
         finish_stages(
             &mut self.later,
             self.wall_view,
@@ -477,7 +483,7 @@ impl Session {
                         .collect()
                 })
             },
-            plan_findings,
+            &findings,
         )?;
         Ok(done)
     }
@@ -849,12 +855,12 @@ fn finish_stages(
 }
 
 /// Shapes the sections `ks` of `model`, split over the machine's cores when there is enough work.
-fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<Section> {
+fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<(Section, crate::shape::Folds)> {
     let per_section = model.loft.samples().max(1);
     crate::parallel::map_ranges(
         ks.len(),
         crate::parallel::PARALLEL_POINTS / per_section,
-        |r| ks[r].iter().map(|&k| model.section(k)).collect(),
+        |r| ks[r].iter().map(|&k| model.section_with_folds(k)).collect(),
     )
 }
 
@@ -1230,5 +1236,35 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         }
         assert!(trimmed > 100, "only {trimmed} columns on a fold's corner");
         assert!(s.vertical_line_curve(1, angle).is_empty());
+        // Said among the corrections: one run of folded sections, every column moved counted.
+        let job = s.job().unwrap();
+        let folds: Vec<_> = job
+            .surface
+            .findings
+            .iter()
+            .filter(|f| f.kind == crate::report::FindingKind::Folds)
+            .collect();
+        assert_eq!(folds.len(), 1, "{folds:?}");
+        assert!(
+            folds[0].corrected && folds[0].points >= trimmed,
+            "{:?}",
+            folds[0]
+        );
+        assert!(
+            folds[0].amount_mm > 0.1 && folds[0].amount_mm < 10.0,
+            "{:?}",
+            folds[0]
+        );
+        // Without the belly, no fold and nothing said.
+        let mut plain = d.clone();
+        plain.control.vertical.clear();
+        s.update(&plain).unwrap();
+        let job = s.job().unwrap();
+        assert!(
+            !job.surface
+                .findings
+                .iter()
+                .any(|f| f.kind == crate::report::FindingKind::Folds)
+        );
     }
 }

@@ -37,6 +37,43 @@ fn swallowtail_reach(samples: usize) -> usize {
     (samples / 12).max(8)
 }
 
+/// What cutting off a section's folds did ([`ShapeModel::section_with_folds`]): how many of its
+/// points were moved onto the folds' corners, and the farthest, mm.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Folds {
+    pub points: usize,
+    pub most_mm: f64,
+}
+
+/// The findings of the sections' folds (`folds[k]`: section k's), one per run of folded
+/// sections: where the shape cut off the swallowtails of a push past the contour's curvature.
+pub fn fold_findings(folds: &[Folds]) -> Vec<Finding> {
+    let mut out: Vec<Finding> = Vec::new();
+    for (k, f) in folds.iter().enumerate().filter(|(_, f)| f.points > 0) {
+        match out.last_mut() {
+            Some(last) if last.layers.1 + 1 == k => {
+                last.layers.1 = k;
+                last.points += f.points;
+                last.amount_mm = last.amount_mm.max(f.most_mm);
+            }
+            _ => out.push(Finding {
+                kind: FindingKind::Folds,
+                corrected: true,
+                layers: (k, k),
+                points: f.points,
+                amount_mm: f.most_mm,
+                message: String::new(),
+            }),
+        }
+    }
+    for f in &mut out {
+        f.message = "the control lines push the wall out of the contour's hollows further than \
+            they curve, so it would fold back on itself: the folds are cut off at their corners"
+            .into();
+    }
+    out
+}
+
 /// Everything needed to compute any section of the shaped (uncorrected, untextured) surface.
 #[derive(Debug, Clone)]
 pub struct ShapeModel {
@@ -137,6 +174,11 @@ impl ShapeModel {
     /// The shaped section k: loft, vertical control offsets along the normal, z with horizontal
     /// control offsets. This is the per-section entry point the app calls for dirty sections.
     pub fn section(&self, k: usize) -> Section {
+        self.section_with_folds(k).0
+    }
+
+    /// [`ShapeModel::section`], with what cutting off its folds did.
+    pub fn section_with_folds(&self, k: usize) -> (Section, Folds) {
         let t = k as f64 / self.layers as f64;
         let z0 = (k > 0).then_some(k as f64 * self.layer_pitch);
         self.shaped_section(t, z0)
@@ -147,15 +189,17 @@ impl ShapeModel {
     pub fn section_at(&self, t: f64) -> Section {
         let t = t.clamp(0.0, 1.0);
         self.shaped_section(t, (t > 0.0).then_some(t * self.height))
+            .0
     }
 
     /// The shaped points at height fraction t; `z0` is the nominal height (`None` on the bed,
     /// where z = 0 whatever the horizontal lines do).
-    fn shaped_section(&self, t: f64, z0: Option<f64>) -> Section {
+    fn shaped_section(&self, t: f64, z0: Option<f64>) -> (Section, Folds) {
         let n = self.loft.samples();
         let xy: Vec<DVec2> = (0..n).map(|i| self.loft.point(i, t)).collect();
         let active = self.active_vertical(t, None);
         let mut wall = xy.clone();
+        let mut folds = Folds::default();
         if !active.is_empty() {
             let normals = outward_normals(&xy);
             for (i, p) in wall.iter_mut().enumerate() {
@@ -163,14 +207,14 @@ impl ShapeModel {
                     *p += normals[i] * (d * self.weights[*l][i]);
                 }
             }
-            trim_swallowtails(&mut wall, &xy, swallowtail_reach(n));
+            (folds.points, folds.most_mm) = trim_swallowtails(&mut wall, &xy, swallowtail_reach(n));
         }
         let points = wall
             .iter()
             .enumerate()
             .map(|(i, p)| DVec3::new(p.x, p.y, z0.map_or(0.0, |z0| z0 + self.dz(i, t))))
             .collect();
-        Section { points }
+        (Section { points }, folds)
     }
 
     /// The vertical lines (by index) with a non-zero offset at t and that offset, leaving out
@@ -230,7 +274,7 @@ impl ShapeModel {
         // Pushed out, the wall may fold back on itself here, which only the whole section
         // shows (`trim_swallowtails`): the point is the section's, and the base is that point
         // less the line's own push.
-        let wall = self.shaped_section(t, z0).points[i];
+        let wall = self.shaped_section(t, z0).0.points[i];
         let own = line
             .and_then(|l| active.iter().find(|(k, _)| *k == l))
             .map_or(0.0, |(_, d)| *d);

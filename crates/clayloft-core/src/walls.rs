@@ -86,6 +86,13 @@ pub fn inner_beads(
 fn offset_section(section: &Section, depth: f64, n: usize) -> Option<Section> {
     let xy = section.xy();
     let mut rings = crate::base_fill::inward_offset_rings(&xy, depth)?;
+    if rings.is_empty() {
+        // The offsetting library (cavalier_contours 0.9) now and then finds nothing inside a ring
+        // plainly wide enough: a section of a 36 mm wide vessel offset 3 mm (found by
+        // `any_vessel_gives_one_printable_spiral`, tested below). The same ring resampled at
+        // equal arc length (its points on the ring, within a sagitta of its corners) offsets.
+        rings = crate::base_fill::inward_offset_rings(&resample_closed(&xy, xy.len()), depth)?;
+    }
     if rings.len() != 1 && crate::geometry::find_self_intersection(&xy).is_some() {
         // A section that crosses itself (a deep texture folded on a tight curve): the offset of
         // the section without its small loops (which the inner bead would round away anyway).
@@ -248,6 +255,34 @@ mod tests {
                 let d = distance_to(&outer, *q);
                 assert!(d > 3.0 - 0.05, "layer {k}: {q} {d}");
             }
+        }
+    }
+
+    /// A vessel 36 mm across whose section 35 the offsetting library leaves empty when offset
+    /// 3 mm inward as it is (the case `any_vessel_gives_one_printable_spiral` found): the bead
+    /// is offset from the section resampled, 3 mm inside it.
+    #[test]
+    fn a_wide_section_the_library_cannot_offset_gets_its_inner_bead() {
+        let d = parse_design(
+            "version = 1\n[printer]\nlayer_height = 0.5\nmin_layer_height = 0.125\n\
+             [shape]\nheight = 38.23433352529929\nsamples = 241\nbase_layers = 0\nwalls = 2\n\
+             [shape.lower]\ntype = \"circle\"\nradius = 20.42491727500761\n\
+             [shape.upper]\ntype = \"rose\"\nradius = 28.850951106383206\n\
+             amplitude = 4.130341755074595\npetals = 6\n\
+             [[control.vertical]]\npoints = [[0.0, 0.0], [0.5, -4.359722931641384], [1.0, 0.0]]\n",
+        )
+        .unwrap();
+        let s = build_surface(&d).unwrap();
+        let xy = s.sections[35].xy();
+        assert_eq!(
+            crate::base_fill::inward_offset_rings(&xy, 3.0).map(|r| r.len()),
+            Some(0),
+            "the library offsets this section now: the workaround may go"
+        );
+        let bead = &inner_beads(&s, 2, 3.0, None).unwrap()[0];
+        for q in bead[35].xy().iter().step_by(5) {
+            let d = distance_to(&xy, *q);
+            assert!((d - 3.0).abs() < 0.05, "{q}: {d} mm inside");
         }
     }
 
