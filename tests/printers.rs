@@ -147,11 +147,13 @@ fn prints_and_checks(dir: &std::path::Path, design: &str, profile: &str) -> Stri
 }
 
 /// The petal vase on the printers of the widest beads: where the belly pushes the wall out of
-/// the rose's valleys, the layer below turns a sharp corner (a little loop at its tip), and the
-/// point above lies just past the tip, past the end of both short segments that meet there.
-/// The self-check found nothing under it ("unsupported", or resting on the layer under that: "a
-/// layer too thick") and refused all three; it now takes the corner for what the point rests
-/// on. Each prints, and `check` accepts the file.
+/// the rose's valleys, the layer below turns a sharp corner (where the shape cuts the fold off;
+/// before 2026-12-06 at the tip of a little loop), and the point above lies just past the tip,
+/// past the end of both short segments that meet there. The self-check found nothing under it
+/// ("unsupported", or resting on the layer under that: "a layer too thick") and refused all
+/// three; it now takes the corner for what the point rests on. Each prints, and `check` accepts
+/// the file. (With the corner rule switched off, all three are still refused, 2026-12-06: layer
+/// too thick at 1–4 points.)
 #[test]
 fn a_wall_past_the_corners_of_the_layer_below_prints() {
     let dir = tempfile::tempdir().unwrap();

@@ -62,14 +62,12 @@ pub fn fold_findings(folds: &[Folds]) -> Vec<Finding> {
                 layers: (k, k),
                 points: f.points,
                 amount_mm: f.most_mm,
-                message: String::new(),
+                message: "the control lines push the wall out of the contour's hollows further \
+                    than they curve, so it would fold back on itself: the folds are cut off at \
+                    their corners"
+                    .into(),
             }),
         }
-    }
-    for f in &mut out {
-        f.message = "the control lines push the wall out of the contour's hollows further than \
-            they curve, so it would fold back on itself: the folds are cut off at their corners"
-            .into();
     }
     out
 }
