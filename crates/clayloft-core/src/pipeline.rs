@@ -129,10 +129,24 @@ pub fn finish_sections(
         // SPEC §14; only a printer set steeper than about 56° reaches it).
         let tan = overhang_tan_limit(design)
             .min(0.5 * design.printer.line_width / grid.layer_pitch.max(1e-9));
-        let events = match displacements {
+        let lowered = match displacements {
             Some(disp) => apply_displacements(&mut sections, disp, tan, enforce),
             None => apply_texture(&mut sections, tex, tan, enforce),
         };
+        // Made whether or not the limits are enforced: a fold is not a shape the design asks
+        // for but the texture's offset turning the wall back on itself (as the shape's folds).
+        findings.extend(group_events(
+            &lowered.folds,
+            FindingKind::Texture,
+            true,
+            usize::MAX,
+            |mm| {
+                format!(
+                    "texture amplitude lowered by up to {mm:.2} mm where the wall turns more sharply than the texture is deep, so that it does not fold back on itself"
+                )
+            },
+        ));
+        let events = lowered.overhang;
         if !events.is_empty() {
             let columns = events.len();
             let mut f = group_events(&events, FindingKind::Texture, enforce, usize::MAX, |mm| {

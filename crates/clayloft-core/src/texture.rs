@@ -59,7 +59,7 @@ pub fn apply_texture(
     tex: &Texture,
     tan_limit: f64,
     enforce: bool,
-) -> Vec<crate::report::PointEvent> {
+) -> TextureLowered {
     let n = sections.first().map_or(0, |s| s.points.len());
     let disp = displacements(tex, n, sections.len());
     apply_displacements(sections, &disp, tan_limit, enforce)
@@ -100,14 +100,37 @@ pub fn apply_displacements(
     disp: &[Vec<f64>],
     tan_limit: f64,
     enforce: bool,
-) -> Vec<crate::report::PointEvent> {
+) -> TextureLowered {
     let n = sections.first().map_or(0, |s| s.points.len());
     if n == 0 {
-        return Vec::new();
+        return TextureLowered::default();
     }
     let parts = crate::parallel::ranges(n, 128);
     let typical: Vec<f64> = sections.iter().map(typical_chord).collect();
     let typical = &typical;
+    // Each section's texture faded where it would fold the ring (none where it does not).
+    let faded: Vec<Option<FoldFade>> = {
+        let sections = &*sections;
+        crate::parallel::map_ranges(sections.len(), crate::parallel::PARALLEL_POINTS / n, |ks| {
+            ks.map(|k| fold_fade(&sections[k].points, &disp[k], typical[k]))
+                .collect()
+        })
+    };
+    let folds = faded
+        .iter()
+        .enumerate()
+        .filter_map(|(k, f)| f.as_ref().map(|f| (k, f)))
+        .flat_map(|(layer, f)| {
+            f.lowered
+                .iter()
+                .map(move |&(sample, amount_mm)| crate::report::PointEvent {
+                    layer,
+                    sample,
+                    amount_mm,
+                })
+        })
+        .collect();
+    let faded = &faded;
     // The columns just outside each part, as they are before the texture.
     let column = |i: usize| -> Vec<glam::DVec2> {
         sections.iter().map(|s| s.points[i].truncate()).collect()
@@ -136,23 +159,187 @@ pub fn apply_displacements(
             cols,
             part,
             (&left, &right),
-            typical,
+            (typical, faded),
             disp,
             tan_limit,
             enforce,
         )
     };
-    let mut events = Vec::new();
+    let mut overhang = Vec::new();
     if work.len() == 1 {
         for item in work {
-            events = part_work(item);
+            overhang = part_work(item);
         }
-        return events;
+    } else {
+        for part in crate::parallel::run_parts(work.map(|item| move || part_work(item)).collect()) {
+            overhang.extend(part);
+        }
     }
-    for part in crate::parallel::run_parts(work.map(|item| move || part_work(item)).collect()) {
-        events.extend(part);
+    TextureLowered { overhang, folds }
+}
+
+/// Where [`apply_displacements`] lowered the texture: one event per column lowered to keep the
+/// overhang limit (at the layer where it binds), and one per point faded so as not to fold the
+/// wall ([`fold_fade`]); amounts in mm of texture removed.
+#[derive(Debug, Default)]
+pub struct TextureLowered {
+    pub overhang: Vec<crate::report::PointEvent>,
+    pub folds: Vec<crate::report::PointEvent>,
+}
+
+/// How far, in samples, [`fold_fade`] looks on either side of a point where the wall turns
+/// more sharply than the texture is deep: a fold whose loop spans up to twice this is seen.
+const FOLD_REACH: usize = 16;
+
+/// Rounds of [`fold_fade`] that halve a fold's texture; the next ones take all of it, and after
+/// [`FOLD_ROUNDS`] what still folds is left as it is.
+const FOLD_HALVINGS: usize = 6;
+const FOLD_ROUNDS: usize = FOLD_HALVINGS + 4;
+
+/// One section's texture faded where it would fold the wall back on itself.
+#[derive(Debug)]
+struct FoldFade {
+    /// Every point's shift along its outward normal, mm (the squeeze's fade included).
+    shifts: Vec<f64>,
+    /// The points faded, and by how much, mm.
+    lowered: Vec<(usize, f64)>,
+}
+
+/// The texture's shifts on one section (`points`, untextured; `disp`, its displacements;
+/// `typical`, its typical chord), faded where they would fold the ring back on itself; none
+/// when nothing folds (the shifts are then `disp · squeeze_fade`, as the columns find them).
+///
+/// Displacing along the normals by `s` offsets the wall, and an offset folds where it is deeper
+/// than the wall's radius of curvature there (`s κ > 1`): at a sharp tip pushed in, a sharp
+/// valley pushed out, the corner of a cut fold. The points beside it change places and the
+/// nozzle traces an X or a loop. So only around the points where the ring turns more sharply
+/// than twice the deepest shift allows (`|nᵢ₊₁ − nᵢ| · 2 max|s| > |pᵢ₊₁ − pᵢ|`), within
+/// [`FOLD_REACH`] points, the displaced ring `q = p + s n` is searched for segments that cross
+/// another and for chords `qᵢ → qᵢ₊ₘ` that point against `pᵢ → pᵢ₊ₘ` (a stretch run
+/// backwards). The ends of each have their texture halved, round by round, then taken away:
+/// the untextured ring (s = 0) has neither. The fade comes before the overhang's scale,
+/// which is worked out on the faded shifts.
+fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> Option<FoldFade> {
+    use glam::DVec2;
+    let n = points.len();
+    if n < 4 || disp.iter().all(|&d| d == 0.0) {
+        return None;
     }
-    events
+    let at = |i: usize| if i < n { i } else { i - n };
+    let p: Vec<DVec2> = points.iter().map(|q| q.truncate()).collect();
+    let (normals, given): (Vec<DVec2>, Vec<f64>) = (0..n)
+        .map(|i| {
+            let (b, a) = crate::geometry::ring_neighbours(i, n);
+            let shift = disp[i] * squeeze_fade(p[b], p[a], typical);
+            (crate::geometry::normal_from_neighbours(p[b], p[a]), shift)
+        })
+        .unzip();
+    // Twice the deepest shift: the normals from neighbours spread a corner's turn over two
+    // points, so a corner looks half as sharp as it is.
+    let deepest = 2.0 * given.iter().fold(0.0_f64, |m, s| m.max(s.abs()));
+    // The stretches around the sharp turns, as (first point, points), wrapping, apart.
+    let mut stretches: Vec<(usize, usize)> = Vec::new();
+    let reach = FOLD_REACH.min(n / 2 - 1);
+    let mut covered = 0; // points of the ring up to which the last stretch reaches
+    for i in 0..n {
+        let j = at(i + 1);
+        let sharp = (normals[j] - normals[i]).length_squared() * deepest * deepest
+            > (p[j] - p[i]).length_squared();
+        if !sharp {
+            continue;
+        }
+        let (from, to) = (i + n - reach, i + n + 1 + reach); // in 0..3n, `to` exclusive
+        match stretches.last_mut() {
+            Some((first, len)) if from <= covered => {
+                *len = (to - *first).min(n);
+                covered = to;
+            }
+            _ => {
+                stretches.push((from, to - from));
+                covered = to;
+            }
+        }
+    }
+    if stretches.is_empty() {
+        return None;
+    }
+    // A last stretch reaching round to the first one: the whole ring, once.
+    if let (Some(&(first, _)), Some(&(last, len))) = (stretches.first(), stretches.last())
+        && stretches.len() > 1
+        && last + len >= first + n
+    {
+        stretches = vec![(first, n)];
+    }
+    let mut q: Vec<DVec2> = (0..n).map(|i| p[i] + normals[i] * given[i]).collect();
+    let mut shifts = given.clone();
+    let mut folded = vec![false; n];
+    // A stretch found clean stays clean: only its own points move.
+    let mut active = vec![true; stretches.len()];
+    let (mut ps, mut qs) = (Vec::new(), Vec::new());
+    for round in 0..FOLD_ROUNDS {
+        let mut found = false;
+        for (&(first, len), active) in stretches.iter().zip(&mut active) {
+            if !*active {
+                continue;
+            }
+            ps.clear();
+            qs.clear();
+            ps.extend((first..first + len).map(|i| p[i % n]));
+            qs.extend((first..first + len).map(|i| q[i % n]));
+            *active = mark_folds(&ps, &qs, reach, |k| folded[(first + k) % n] = true);
+            found |= *active;
+        }
+        if !found {
+            break;
+        }
+        let factor = if round < FOLD_HALVINGS { 0.5 } else { 0.0 };
+        for i in 0..n {
+            if std::mem::take(&mut folded[i]) {
+                shifts[i] *= factor;
+                q[i] = p[i] + normals[i] * shifts[i];
+            }
+        }
+    }
+    let lowered: Vec<(usize, f64)> = (0..n)
+        .filter(|&i| shifts[i] != given[i])
+        .map(|i| (i, (given[i] - shifts[i]).abs()))
+        .collect();
+    (!lowered.is_empty()).then_some(FoldFade { shifts, lowered })
+}
+
+/// Marks (by `mark(k)`) the ends of the chords `qₖ → qₖ₊ₘ` (m ≤ `reach`) of a stretch that
+/// point against `pₖ → pₖ₊ₘ`, and of the segments that cross one `m ≥ 2` further on; whether
+/// any.
+fn mark_folds(
+    p: &[glam::DVec2],
+    q: &[glam::DVec2],
+    reach: usize,
+    mut mark: impl FnMut(usize),
+) -> bool {
+    let len = q.len();
+    let mut any = false;
+    for a in 0..len {
+        for b in a + 1..=(a + reach).min(len - 1) {
+            if (q[b] - q[a]).dot(p[b] - p[a]) < 0.0 {
+                any = true;
+                mark(a);
+                mark(b);
+            }
+            // Segment a (a → a + 1) and segment b (b → b + 1), not neighbours.
+            if b >= a + 2 && b + 1 < len {
+                let (a0, a1, b0, b1) = (q[a], q[a + 1], q[b], q[b + 1]);
+                let apart =
+                    a0.max(a1).cmplt(b0.min(b1)).any() || b0.max(b1).cmplt(a0.min(a1)).any();
+                if !apart && crate::geometry::segments_intersect(a0, a1, b0, b1) {
+                    any = true;
+                    for k in [a, a + 1, b, b + 1] {
+                        mark(k);
+                    }
+                }
+            }
+        }
+    }
+    any
 }
 
 /// Columns closer together than this share of their section's typical spacing are squeezed
@@ -217,14 +404,15 @@ fn admissible_scale(
 
 /// [`apply_displacements`] on the columns `cols` (`part[k]`: section k's points there; `left`,
 /// `right`: each section's point just before and after them; `typical`: each section's typical
-/// chord): the normals before the texture and the displacements faded where the columns are
-/// squeezed, the largest admissible scale of each column and the layer where it binds, the
-/// shifts; the columns scaled down, in order.
+/// chord; `faded`: each section's shifts where [`fold_fade`] faded them): the normals before the
+/// texture and the displacements faded where the columns are squeezed (or as `faded` has them),
+/// the largest admissible scale of each column and the layer where it binds, the shifts; the
+/// columns scaled down, in order.
 fn texture_columns(
     cols: std::ops::Range<usize>,
     mut part: Vec<&mut [glam::DVec3]>,
     (left, right): (&[glam::DVec2], &[glam::DVec2]),
-    typical: &[f64],
+    (typical, faded): (&[f64], &[Option<FoldFade>]),
     disp: &[Vec<f64>],
     tan_limit: f64,
     enforce: bool,
@@ -235,6 +423,7 @@ fn texture_columns(
     let mut normals = Vec::with_capacity(count * w);
     let mut shifts = Vec::with_capacity(count * w);
     for (k, row) in part.iter().enumerate() {
+        let faded = faded[k].as_ref().map(|f| &f.shifts[cols.clone()]);
         for c in 0..w {
             let before = if c == 0 {
                 left[k]
@@ -247,7 +436,10 @@ fn texture_columns(
                 row[c + 1].truncate()
             };
             normals.push(crate::geometry::normal_from_neighbours(before, after));
-            shifts.push(disp[k][cols.start + c] * squeeze_fade(before, after, typical[k]));
+            shifts.push(match faded {
+                Some(faded) => faded[c],
+                None => disp[k][cols.start + c] * squeeze_fade(before, after, typical[k]),
+            });
         }
     }
     // Largest admissible scale per column, and the layer where it binds.
@@ -385,6 +577,7 @@ mod tests {
                 let (mut ours, mut reference) = (sections.clone(), sections);
                 let events: Vec<(usize, usize, u64)> =
                     apply_displacements(&mut ours, &disp, 1.0, enforce)
+                        .overhang
                         .iter()
                         .map(|e| (e.layer, e.sample, e.amount_mm.to_bits()))
                         .collect();
@@ -402,6 +595,86 @@ mod tests {
                             "{n}"
                         );
                     }
+                }
+            }
+        }
+    }
+
+    /// A four-pointed star's ring (outer radius 26.75, inner 13.23: tips of about 50°), `n`
+    /// points spaced evenly along it, at height `z`.
+    fn star(n: usize, z: f64) -> crate::section::Section {
+        let corners: Vec<glam::DVec2> = (0..8)
+            .map(|c| {
+                let r = if c % 2 == 0 { 26.75 } else { 13.23 };
+                glam::DVec2::from_angle(std::f64::consts::TAU * c as f64 / 8.0) * r
+            })
+            .collect();
+        let ring = crate::geometry::resample_closed(&corners, n);
+        crate::section::Section {
+            points: ring.iter().map(|p| p.extend(z)).collect(),
+        }
+    }
+
+    /// Segments of a ring that cross another segment of it.
+    fn crossing_segments(ring: &[glam::DVec2]) -> usize {
+        let n = ring.len();
+        let seg = |i: usize| (ring[i], ring[(i + 1) % n]);
+        (0..n)
+            .filter(|&i| {
+                (0..n).any(|j| {
+                    let near = j == i || (j + 1) % n == i || (i + 1) % n == j;
+                    let ((a0, a1), (b0, b1)) = (seg(i), seg(j));
+                    !near && crate::geometry::segments_intersect(a0, a1, b0, b1)
+                })
+            })
+            .count()
+    }
+
+    /// A texture deeper than a sharp tip is wide (1.8 mm inward, or a zig-zag of ±1.4 mm every
+    /// other point, on the tips of a four-pointed star 60 or 200 points round) makes the
+    /// points beside each tip change places: the ring crosses itself there. Faded where it
+    /// would cross or run back, it does not, the tips lose only part of their texture, and the
+    /// flanks keep all of it.
+    #[test]
+    fn a_texture_deeper_than_a_tip_is_wide_does_not_fold_it() {
+        type ShiftAt = fn(usize) -> f64;
+        let textures: [(usize, ShiftAt); 2] = [
+            (60, |_| -1.8),
+            (200, |i| 1.41 * [1.0, 0.0, -1.0, 0.0][i % 4]),
+        ];
+        for (n, texture) in textures {
+            let before = vec![star(n, 0.0), star(n, 0.5)];
+            let disp = vec![(0..n).map(texture).collect::<Vec<f64>>(); 2];
+            let ring = |s: &crate::section::Section| -> Vec<glam::DVec2> {
+                s.points.iter().map(|p| p.truncate()).collect()
+            };
+            // Displaced along the normals as given, it crosses itself.
+            let normals = before[1].normals();
+            let raw: Vec<glam::DVec2> = (0..n)
+                .map(|i| before[1].points[i].truncate() + normals[i] * disp[1][i])
+                .collect();
+            assert!(crossing_segments(&raw) > 0, "{n}: the test needs a fold");
+            let mut after = before.clone();
+            let lowered = apply_displacements(&mut after, &disp, 1e9, true);
+            assert!(lowered.overhang.is_empty(), "{n}");
+            assert_eq!(crossing_segments(&ring(&after[1])), 0, "{n}");
+            assert!(!lowered.folds.is_empty(), "{n}");
+            assert!(
+                lowered.folds.len() < n / 2,
+                "{n}: {} faded",
+                lowered.folds.len()
+            );
+            // The flanks, a tenth of the ring away from each tip, keep their texture.
+            let pairs = after[1].points.iter().zip(&before[1].points);
+            for (i, ((moved_to, was), d)) in pairs.zip(&disp[1]).enumerate() {
+                let from_tip = (0..4)
+                    .map(|t| (i as i64 - (t * n / 4) as i64).rem_euclid(n as i64))
+                    .map(|d| d.min(n as i64 - d))
+                    .min()
+                    .unwrap();
+                if from_tip as usize > n / 10 {
+                    let moved = moved_to.distance(*was);
+                    assert!((moved - d.abs()).abs() < 1e-9, "{n}: point {i}");
                 }
             }
         }
@@ -433,8 +706,8 @@ mod tests {
         };
         let before = vec![ring(0.0), ring(0.5)];
         let mut after = before.clone();
-        let events = apply_displacements(&mut after, &vec![vec![1.0; n]; 2], 1e9, true);
-        assert!(events.is_empty());
+        let lowered = apply_displacements(&mut after, &vec![vec![1.0; n]; 2], 1e9, true);
+        assert!(lowered.overhang.is_empty() && lowered.folds.is_empty());
         for i in 0..n {
             let moved = after[1].points[i].distance(before[1].points[i]);
             // The squeezed chords against the typical (the ring's mean, a little longer than

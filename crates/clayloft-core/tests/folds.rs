@@ -1,6 +1,7 @@
 //! A belly pushed out of a rose's valleys past their radius of curvature folds the offset wall
 //! into swallowtails; the shape cuts them off at their corners and the texture fades over the
-//! squeezed columns, so the printed path turns each corner once instead of tracing a loop.
+//! squeezed columns, so the printed path turns each corner once instead of tracing a loop. A
+//! texture deeper than a sharp tip is wide folds it too; it fades there.
 
 use clayloft_core::geometry::segments_intersect;
 use glam::DVec2;
@@ -40,5 +41,73 @@ fn bellied_roses_print_without_loops() {
         let points = toolpath_of(design);
         assert!(points.len() > 40_000, "{design}");
         assert_eq!(looping_segments(&points, z_min, 60), 0, "{design}");
+    }
+}
+
+/// Found by random designs (2026-12-06): a texture deeper than a star's tips are wide. A square
+/// wave 1.78 mm deep on a four-pointed star's foot made an X at every tip, every layer (55
+/// looping segments); a zig-zag of ±1.41 mm every other point, 37 loops 3.3 mm across. Both
+/// printed with every limit holding. The texture now fades where it would fold the wall.
+#[test]
+fn textures_deeper_than_a_tip_is_wide_print_without_loops() {
+    let square_on_tips = r#"
+version = 1
+name = "star foot, square wave"
+[printer]
+layer_height = 0.5
+[shape]
+height = 113.0
+samples = 60
+base_layers = 3
+[shape.lower]
+type = "star"
+points = 4
+outer_radius = 26.75
+inner_radius = 13.23
+[shape.upper]
+type = "ellipse"
+rx = 27.12
+ry = 24.35
+[texture]
+combine = "sum"
+x = { wave = "square", period = 25, amplitude = 1.78 }
+"#;
+    let zig_zag = r#"
+version = 1
+name = "star foot, zig-zag"
+[printer]
+layer_height = 0.8
+[shape]
+height = 87.1
+samples = 200
+base_layers = 0
+[shape.lower]
+type = "star"
+points = 4
+outer_radius = 24.53
+inner_radius = 16.49
+[shape.upper]
+type = "spline"
+points = [[27.07, 5.97], [-10.00, 14.50], [-12.32, -23.98]]
+[texture]
+x = { wave = "triangle", period = 4, amplitude = 1.41 }
+"#;
+    for (text, z_min, window) in [(square_on_tips, 2.0, 30), (zig_zag, 0.9, 60)] {
+        let design = clayloft_core::load::parse_design(text).unwrap();
+        let job = clayloft_core::run(&design).unwrap();
+        let points: Vec<glam::DVec3> = job.toolpath.points.iter().map(|q| q.pos).collect();
+        assert_eq!(
+            looping_segments(&points, z_min, window),
+            0,
+            "{}",
+            design.name
+        );
+        let said = job.findings().map(|f| f.to_string()).collect::<Vec<_>>();
+        assert!(
+            said.iter()
+                .any(|f| f.contains("does not fold back on itself")),
+            "{}: {said:?}",
+            design.name
+        );
     }
 }
