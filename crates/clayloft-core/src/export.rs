@@ -34,14 +34,15 @@ pub enum ExportError {
     Unreadable { file: String, error: GcodeError },
     /// The program breaks a limit of its printer: the worst-reported violation.
     #[error(
-        "does not print on this printer ({printer}): {what} at {count} points, worst {worst:.2} ({detail}); {}",
+        "does not print on this printer ({printer}): {what} at {count} points{worst} ({detail}); {}",
         advice(what)
     )]
     Refused {
         printer: String,
         what: &'static str,
         count: usize,
-        worst: f64,
+        /// ", worst 0.19 mm short", or nothing where the limit has no measure.
+        worst: String,
         detail: String,
     },
 }
@@ -122,7 +123,7 @@ fn refusal(design: &Design, report: Option<&CheckReport>) -> Option<ExportError>
             .unwrap_or_else(|| "the paper's printer".into()),
         what: v.what,
         count: v.count,
-        worst: v.worst,
+        worst: v.worst_said(2),
         detail: v.detail.clone(),
     })
 }
@@ -168,6 +169,27 @@ mod tests {
         ] {
             assert!(advice(what).contains("finer bead"), "{what}");
         }
+    }
+
+    /// A refusal says how far the worst point is past the limit, in the limit's own unit: a
+    /// vessel of 1 mm layers (thinner where the spiral leaves the flat first revolution) on a
+    /// printer that now lays them no thinner than 1.05 mm.
+    #[test]
+    fn a_refusal_says_the_worst_in_its_unit() {
+        let (mut d, job) = vessel("");
+        d.printer.min_layer_height = 1.05;
+        d.printer.max_layer_height = 1.2;
+        let program = crate::gcode::program(&d, &job).unwrap();
+        let e = verify_program(&d, &program.text).expect_err("refused");
+        let said = e.to_string();
+        let worst = said
+            .split_once(" points, worst ")
+            .and_then(|(_, rest)| rest.split_once(" mm short (below min_layer_height 1.05 mm); "))
+            .and_then(|(number, _)| number.parse::<f64>().ok());
+        assert!(
+            said.contains("layer too thin at ") && worst.is_some_and(|w| (0.05..1.05).contains(&w)),
+            "{said}"
+        );
     }
 
     fn vessel(extra: &str) -> (Design, PrintJob) {
@@ -224,6 +246,8 @@ mod tests {
                 .starts_with("does not print on this printer (the paper's printer): "),
             "{e}"
         );
+        // Off the bed has no measure: no "worst" is said.
+        assert!(!e.to_string().contains("worst"), "{e}");
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
         // A printer host's program in memory: the same refusal.

@@ -715,6 +715,7 @@ fn measure_layers_in(
             what: NOT_MEASURED,
             count: 1,
             worst: report.path_length_mm,
+            unit: " mm of path",
             first_line: lines[0],
             detail: format!(
                 "segments hundreds of bead widths long ({:.0} mm of path in {} chords): layers, overhang and support were not measured",
@@ -723,44 +724,42 @@ fn measure_layers_in(
             ),
         });
     }
-    let mut push = |t: Tally, what: &'static str, detail: String| {
-        report.violations.extend(t.into_violation(what, detail))
+    let mut push = |t: Tally, what: &'static str, unit: &'static str, detail: String| {
+        report
+            .violations
+            .extend(t.into_violation(what, unit, detail))
     };
     push(
         thin,
         "layer too thin",
-        format!(
-            "below min_layer_height {} mm (worst = mm short)",
-            limits.min_layer_height
-        ),
+        " mm short",
+        format!("below min_layer_height {} mm", limits.min_layer_height),
     );
     push(
         thick,
         "layer too thick",
-        format!(
-            "above max_layer_height {} mm (worst = mm over)",
-            limits.max_layer_height
-        ),
+        " mm over",
+        format!("above max_layer_height {} mm", limits.max_layer_height),
     );
     push(
         lean,
         OVERHANG,
-        format!(
-            "wall leans past {}° (worst = degrees)",
-            limits.max_overhang_deg
-        ),
+        "°",
+        format!("wall leans past {}°", limits.max_overhang_deg),
     );
     push(
         unsupported,
         UNSUPPORTED,
-        format!("no printed layer within {radius:.1} mm below (worst = z, mm)"),
+        " mm up (the highest such point)",
+        format!("no printed layer within {radius:.1} mm below"),
     );
     report.max_rise_above_tip = clearance.max_rise;
     push(
         clearance.collide,
         COLLISION,
+        " mm above the holder",
         format!(
-            "printed part rises above the holder, nozzle_length {} mm (worst = mm)",
+            "printed part rises above the holder, nozzle_length {} mm",
             limits.nozzle_length
         ),
     );

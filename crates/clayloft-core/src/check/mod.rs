@@ -254,10 +254,15 @@ fn tally_moves(
         [
             outside.into_violation(
                 OUTSIDE,
+                "",
                 match limits.bed_shape {
                     crate::design::BedShape::Rectangle => format!(
                         "bed {} … {} × {} … {} mm, height 0 … {} mm",
-                        -ox, limits.bed_x - ox, -oy, limits.bed_y - oy, limits.max_z
+                        -ox,
+                        limits.bed_x - ox,
+                        -oy,
+                        limits.bed_y - oy,
+                        limits.max_z
                     ),
                     crate::design::BedShape::Circle => format!(
                         "round bed {} mm across, height 0 … {} mm",
@@ -267,9 +272,14 @@ fn tally_moves(
             ),
             travel.into_violation(
                 NOT_CONTINUOUS,
-                "moves without extrusion between the first and last extruding move (worst = longest, mm)".into(),
+                " mm (the longest)",
+                "moves without extrusion between the first and last extruding move".into(),
             ),
-            retract.into_violation(RETRACTION, "clay printing allows no retraction (worst = mm of E)".into()),
+            retract.into_violation(
+                RETRACTION,
+                " mm of E",
+                "clay printing allows no retraction".into(),
+            ),
         ]
         .into_iter()
         .flatten(),
@@ -290,6 +300,7 @@ pub fn check_path(points: &[DVec3], limits: &Limits) -> CheckReport {
             what: NOT_MEASURED,
             count: 1,
             worst: 0.0,
+            unit: "",
             first_line: 0,
             detail: format!("limits: {e}"),
         });
@@ -451,6 +462,17 @@ mod tests {
         // 1.5 mm outward per 1 mm layer is 56°; steeper where the helix leaves the flat revolution.
         assert!(v.worst >= 56.0, "{}", v.worst);
         assert!(v.count > 500, "{}", v.count);
+        // Said with its unit, once: "worst 56.310°, first at line … (wall leans past 45°)".
+        let said = r.to_string();
+        let line = said
+            .lines()
+            .find(|l| l.starts_with("VIOLATION overhang:"))
+            .unwrap();
+        assert!(
+            line.contains(&format!("worst {:.3}°, first at line", v.worst))
+                && line.ends_with("(wall leans past 45°)"),
+            "{line}"
+        );
         // 0.8 mm per layer in the steady helix is 38.7°: only the thin helix start breaks 45°.
         let mild = check_gcode(&helix(0.8, 10, 1.0), &limits()).unwrap();
         assert!(mild.violations.iter().all(|v| v.count < 200), "{mild}");

@@ -10,8 +10,22 @@ pub struct Violation {
     pub what: &'static str,
     pub count: usize,
     pub worst: f64,
+    /// What `worst` measures, written after it (" mm short", "°"); empty where it measures
+    /// nothing (a point off the bed).
+    pub unit: &'static str,
     pub first_line: usize,
     pub detail: String,
+}
+
+impl Violation {
+    /// ", worst 0.19 mm short" with `decimals`, or nothing where `worst` measures nothing.
+    pub fn worst_said(&self, decimals: usize) -> String {
+        if self.unit.is_empty() {
+            String::new()
+        } else {
+            format!(", worst {:.*}{}", decimals, self.worst, self.unit)
+        }
+    }
 }
 
 /// What the checker measured.
@@ -97,8 +111,12 @@ impl fmt::Display for CheckReport {
             for v in &self.violations {
                 writeln!(
                     f,
-                    "VIOLATION {}: {} moves, worst {:.3}, first at line {} ({})",
-                    v.what, v.count, v.worst, v.first_line, v.detail
+                    "VIOLATION {}: {} moves{}, first at line {} ({})",
+                    v.what,
+                    v.count,
+                    v.worst_said(3),
+                    v.first_line,
+                    v.detail
                 )?;
             }
             write!(f, "{} limit(s) broken", self.violations.len())
@@ -116,11 +134,17 @@ pub(super) struct Tally {
 
 impl Tally {
     /// The violation this tally records, if any.
-    pub(super) fn into_violation(self, what: &'static str, detail: String) -> Option<Violation> {
+    pub(super) fn into_violation(
+        self,
+        what: &'static str,
+        unit: &'static str,
+        detail: String,
+    ) -> Option<Violation> {
         (self.count > 0).then_some(Violation {
             what,
             count: self.count,
             worst: self.worst,
+            unit,
             first_line: self.first_line,
             detail,
         })
