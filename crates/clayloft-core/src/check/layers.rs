@@ -750,14 +750,14 @@ fn measure_layers_in(
     push(
         unsupported,
         UNSUPPORTED,
-        " mm up (the highest such point)",
+        " mm high (z of the highest such point)",
         format!("no printed layer within {radius:.1} mm below"),
     );
     report.max_rise_above_tip = clearance.max_rise;
     push(
         clearance.collide,
         COLLISION,
-        " mm above the holder",
+        " mm above the nozzle tip",
         format!(
             "printed part rises above the holder, nozzle_length {} mm",
             limits.nozzle_length
