@@ -180,7 +180,7 @@ pub fn apply_displacements(
 
 /// Where [`apply_displacements`] lowered the texture: one event per column lowered to keep the
 /// overhang limit (at the layer where it binds), and one per point faded so as not to fold the
-/// wall ([`fold_fade`]); amounts in mm of texture removed.
+/// wall (`fold_fade`); amounts in mm of texture removed.
 #[derive(Debug, Default)]
 pub struct TextureLowered {
     pub overhang: Vec<crate::report::PointEvent>,
