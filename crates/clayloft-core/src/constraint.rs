@@ -1,9 +1,11 @@
 //! Manufacturing constraints (SPEC §2) on the section surface: detect, correct locally, report.
 //!
 //! Support-free: between section k−1 and k the wall may move along the XY normal of section k−1
-//! by at most `Δz·tan(max_overhang)`, with Δz the local layer height. Corrections clamp that
-//! normal component point by point, from the bottom up, so a section only ever depends on the
-//! corrected section below it.
+//! by at most `Δz·tan(max_overhang)`, with Δz the local layer height, and no point may lie
+//! farther than that from the wall below (the nearest point of section k−1's segments around
+//! its column, as the checker measures it: at a sharp corner the two differ). Corrections clamp
+//! point by point, from the bottom up, so a section only ever depends on the corrected section
+//! below it.
 
 use glam::DVec2;
 
@@ -22,8 +24,9 @@ pub struct SurfaceMetrics {
     pub max_layer_height: f64,
 }
 
-/// Clamps the normal offset of every point of sections `from ..` against the section below to
-/// `tan_limit·Δz`. Returns the points moved (or, with `enforce = false`, the points in violation,
+/// Clamps the normal offset of every point of sections `from ..` against the section below, and
+/// its distance from that section's wall, to `tan_limit·Δz` ([`clamp_point`]). Returns the
+/// points moved (or, with `enforce = false`, the points in violation,
 /// unchanged). Also returns the index of the highest section changed, if any.
 pub fn clamp_overhang(
     sections: &mut [Section],
@@ -89,15 +92,16 @@ fn clamp_by_columns(
             rest = tail;
         }
     }
-    // edges[j][r]: part j's first and last point of section start − 1 + r, once finished.
-    let edges: Vec<Vec<OnceLock<(glam::DVec3, glam::DVec3)>>> = (0..count)
+    // edges[j][r]: part j's first and last NEAR_COLUMNS points of section start − 1 + r, once
+    // finished.
+    let edges: Vec<Vec<OnceLock<Edges>>> = (0..count)
         .map(|_| (0..rows).map(|_| OnceLock::new()).collect())
         .collect();
     // Set when a part ends, finished or stopped early (a panic), so that its neighbours do not
     // wait forever for a section it will not finish.
     let ended: Vec<AtomicBool> = (0..count).map(|_| AtomicBool::new(false)).collect();
     let (edges, ended) = (&edges, &ended);
-    let wait = move |j: usize, r: usize| -> (glam::DVec3, glam::DVec3) {
+    let wait = move |j: usize, r: usize| -> Edges {
         let mut spins = 0u32;
         loop {
             if let Some(e) = edges[j][r].get() {
@@ -132,24 +136,30 @@ fn clamp_by_columns(
                 let ColumnPart { columns, mut rows } = part;
                 let w = columns.len();
                 let (left, right) = ((j + count - 1) % count, (j + 1) % count);
-                let _ = edges[j][0].set((rows[0][0], rows[0][w - 1]));
+                let _ = edges[j][0].set(edges_of(rows[0]));
                 let mut events = Vec::new();
                 let mut normals = Vec::with_capacity(w);
+                // The section below, with its neighbours' NEAR_COLUMNS points on either side.
+                let mut padded = Vec::with_capacity(w + 2 * NEAR_COLUMNS);
                 for r in 1..rows.len() {
-                    let before_first = wait(left, r - 1).1;
-                    let after_last = wait(right, r - 1).0;
+                    let (left_edges, right_edges) = (wait(left, r - 1), wait(right, r - 1));
                     let (below, above) = rows.split_at_mut(r);
                     let (prev, cur) = (&*below[r - 1], &mut *above[0]);
+                    padded.clear();
+                    padded.extend_from_slice(&left_edges.1);
+                    padded.extend_from_slice(prev);
+                    padded.extend_from_slice(&right_edges.0);
                     normals.clear();
-                    normals.extend((0..w).map(|c| {
-                        let before = if c == 0 { before_first } else { prev[c - 1] };
-                        let after = if c + 1 == w { after_last } else { prev[c + 1] };
+                    normals.extend(padded.windows(2 * NEAR_COLUMNS + 1).map(|near| {
+                        let (before, after) = (near[NEAR_COLUMNS - 1], near[NEAR_COLUMNS + 1]);
                         crate::geometry::normal_from_neighbours(before.truncate(), after.truncate())
                     }));
                     let layer = start - 1 + r;
-                    for (c, p) in cur.iter_mut().enumerate() {
+                    let near = padded.windows(2 * NEAR_COLUMNS + 1);
+                    for (c, (p, near)) in cur.iter_mut().zip(near).enumerate() {
+                        let near = near.try_into().expect("a window of the padded row");
                         if let Some(amount_mm) =
-                            clamp_point(p, prev[c], normals[c], tan_limit, enforce)
+                            clamp_point(p, near, normals[c], tan_limit, enforce)
                         {
                             events.push(PointEvent {
                                 layer,
@@ -158,7 +168,7 @@ fn clamp_by_columns(
                             });
                         }
                     }
-                    let _ = edges[j][r].set((cur[0], cur[w - 1]));
+                    let _ = edges[j][r].set(edges_of(cur));
                 }
                 events
             }
@@ -173,30 +183,74 @@ fn clamp_by_columns(
     Some(events)
 }
 
-/// Clamps point `p` against `q` below it (`n`: the outward normal of the section below at q);
-/// the excess when it leaned past the limit (moved back onto it when `enforce`).
+/// A part's first and last [`NEAR_COLUMNS`] points of a section, for the parts beside it.
+type Edges = ([glam::DVec3; NEAR_COLUMNS], [glam::DVec3; NEAR_COLUMNS]);
+
+/// The [`Edges`] of a part's row (at least `NEAR_COLUMNS` points).
+fn edges_of(row: &[glam::DVec3]) -> Edges {
+    let w = row.len();
+    (
+        std::array::from_fn(|j| row[j]),
+        std::array::from_fn(|j| row[w - NEAR_COLUMNS + j]),
+    )
+}
+
+/// Points of the section below that [`clamp_point`] measures a point's distance to: its own
+/// column's and [`NEAR_COLUMNS`] on either side.
+const NEAR_COLUMNS: usize = 2;
+
+/// Clamps point `p` against `below[NEAR_COLUMNS]` under it (`n`: the outward normal of the
+/// section below there; `below`: that point and its neighbours on either side); the excess when
+/// it leaned past the limit (moved back onto it when `enforce`).
+///
+/// First the offset along the normal. Then the distance to the wall below as the checker
+/// measures it, to the nearest point of the segments between `below`'s points: where the
+/// samples do not sit at the same place on a sharp corner from one section to the next, a
+/// point may keep its offset along its normal and still lie farther than that from the corner
+/// below (the checker found a rose lofted to a seven-point star leaning 47.8° at three points).
+/// Where that nearest point is an end of `below` (the point slid along the wall past them) the
+/// segments do not say, and it is left.
 #[inline]
 fn clamp_point(
     p: &mut glam::DVec3,
-    q: glam::DVec3,
+    below: &[glam::DVec3; 2 * NEAR_COLUMNS + 1],
     n: DVec2,
     tan_limit: f64,
     enforce: bool,
 ) -> Option<f64> {
+    let q = below[NEAR_COLUMNS];
     let dz = (p.z - q.z).max(0.0);
     let limit = dz * tan_limit;
     let offset = (p.truncate() - q.truncate()).dot(n);
+    let mut excess = None;
+    let mut xy = p.truncate();
     if offset.abs() > limit {
-        let excess = offset.abs() - limit;
-        if enforce {
-            let shift: DVec2 = n * (excess * offset.signum());
-            p.x -= shift.x;
-            p.y -= shift.y;
-        }
-        Some(excess)
-    } else {
-        None
+        excess = Some(offset.abs() - limit);
+        xy -= n * ((offset.abs() - limit) * offset.signum());
     }
+    // Within the limit of q itself, the wall below is nearer still: most points.
+    if (xy - q.truncate()).length_squared() > limit * limit {
+        // The nearest point of the wall below, and whether it is an end of `below`.
+        let mut nearest = (f64::INFINITY, DVec2::ZERO, true);
+        for (s, pair) in below.windows(2).enumerate() {
+            let (a, b) = (pair[0].truncate(), pair[1].truncate());
+            let (d, f) = crate::geometry::point_segment_distance(xy, a, b);
+            if d < nearest.0 {
+                let at_end = (s == 0 && f <= 0.0) || (s + 2 == below.len() && f >= 1.0);
+                nearest = (d, a.lerp(b, f), at_end);
+            }
+        }
+        let (d, x, at_end) = nearest;
+        if !at_end && d > limit {
+            excess = Some(excess.unwrap_or(0.0) + d - limit);
+            xy = x + (xy - x) * (limit / d);
+        }
+    }
+    if enforce && excess.is_some() {
+        p.x = xy.x;
+        p.y = xy.y;
+    }
+    excess
 }
 
 /// [`clamp_overhang`] section by section on one core.
@@ -212,9 +266,11 @@ fn clamp_by_rows(
         let prev = &below[k - 1];
         let cur = &mut above[0];
         let normals = prev.normals();
+        let n = prev.points.len();
         for (i, p) in cur.points.iter_mut().enumerate() {
-            if let Some(amount_mm) = clamp_point(p, prev.points[i], normals[i], tan_limit, enforce)
-            {
+            let below: [glam::DVec3; 2 * NEAR_COLUMNS + 1] =
+                std::array::from_fn(|j| prev.points[(i + n * NEAR_COLUMNS + j - NEAR_COLUMNS) % n]);
+            if let Some(amount_mm) = clamp_point(p, &below, normals[i], tan_limit, enforce) {
                 events.push(PointEvent {
                     layer: k,
                     sample: i,
@@ -378,6 +434,52 @@ fn measure_part(
 mod tests {
     use super::*;
     use glam::DVec3;
+
+    /// A sharp tip (90°, at (0, 10)) whose samples do not sit on the tip from one section to
+    /// the next: the section above has its tip point 1.3 mm out of one side, 1 mm up. Along
+    /// the bisector (the normal the clamp moves against) that is 0.42 mm, within tan 45° · 1 mm;
+    /// from the side below it is 1.3 mm, as the checker measures. The clamp brings it to 1 mm
+    /// (the limit) from the wall below; a point sliding along a straight side, as far from it
+    /// as the limit allows, stays where it is.
+    #[test]
+    fn a_point_past_a_sharp_corner_is_clamped_by_its_distance_to_the_wall_below() {
+        let side = |t: f64| DVec3::new(-10.0 + 10.0 * t, 10.0 * t, 0.0); // the left side
+        let other = |t: f64| DVec3::new(10.0 * t, 10.0 - 10.0 * t, 0.0); // the right side
+        let below = [side(0.6), side(0.8), side(1.0), other(0.2), other(0.4)];
+        let n = DVec2::new(0.0, 1.0); // the bisector at the tip
+        // Up the left side's outward normal (−1, 1)/√2 by 1.3 mm from a point beside the tip.
+        let out = DVec2::new(-1.0, 1.0).normalize();
+        let from = side(0.95).truncate() + out * 1.3;
+        let mut p = from.extend(1.0);
+        let excess = clamp_point(&mut p, &below, n, 1.0, true).expect("clamped");
+        let distance = |p: DVec3| {
+            below
+                .windows(2)
+                .map(|w| {
+                    let (d, _) = crate::geometry::point_segment_distance(
+                        p.truncate(),
+                        w[0].truncate(),
+                        w[1].truncate(),
+                    );
+                    d
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        assert!((distance(from.extend(1.0)) - 1.3).abs() < 1e-9);
+        assert!((distance(p) - 1.0).abs() < 1e-9, "{}", distance(p));
+        assert!((excess - 0.3).abs() < 1e-9, "{excess}");
+        // Without the distance rule it passed: its offset along the bisector.
+        let offset = (from - below[2].truncate()).dot(n);
+        assert!(offset < 1.0, "{offset}");
+        // The wall beside the tip just inside the limit, sliding along the side: 0.99 mm out
+        // of the left side and 1.5 mm along it from its column's point below.
+        let along = DVec2::new(1.0, 1.0).normalize();
+        let beside = (side(0.5).truncate() + along * 1.5 + out * 0.99).extend(1.0);
+        let near = [side(0.3), side(0.4), side(0.5), side(0.6), side(0.7)];
+        let mut q = beside;
+        assert_eq!(clamp_point(&mut q, &near, out, 1.0, true), None);
+        assert_eq!(q, beside);
+    }
 
     /// The clamp by columns on all cores moves every point exactly as the clamp section by
     /// section, and reports the same events in the same order: a wavy, leaning wall with many
