@@ -25,7 +25,7 @@ pub struct SurfaceMetrics {
 }
 
 /// Clamps the normal offset of every point of sections `from ..` against the section below, and
-/// its distance from that section's wall, to `tan_limit·Δz` ([`clamp_point`]). Returns the
+/// its distance from that section's wall, to `tan_limit·Δz` (`clamp_point`). Returns the
 /// points moved (or, with `enforce = false`, the points in violation,
 /// unchanged). Also returns the index of the highest section changed, if any.
 pub fn clamp_overhang(
