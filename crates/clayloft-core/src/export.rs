@@ -56,7 +56,7 @@ fn advice(what: &str) -> &'static str {
     } else if what == OUTSIDE {
         "the printer's start or end G-code moves outside the machine, or the vessel does not fit it"
     } else {
-        "try a printer with a finer bead or thinner layers, or a simpler contour"
+        "try a printer with a finer bead or thinner layers, or a simpler contour, gentler control lines or a shallower texture (its corrections, in `clayloft info` or the app's Constraints panel, say where the shape had to change)"
     }
 }
 
