@@ -244,6 +244,13 @@ fn clamp_point(
         if !at_end && d > limit {
             excess = Some(excess.unwrap_or(0.0) + d - limit);
             xy = x + (xy - x) * (limit / d);
+            // Towards a side that turns outward (a concave corner) that can lean the point
+            // past the limit along the normal again: the normal's limit holds (the surface's
+            // lean is measured along it).
+            let offset = (xy - q.truncate()).dot(n);
+            if offset.abs() > limit {
+                xy -= n * ((offset.abs() - limit) * offset.signum());
+            }
         }
     }
     if enforce && excess.is_some() {

@@ -156,7 +156,7 @@ mod tests {
 
     /// A refusal says what a potter can change: the printer's G-code for a break of the one
     /// path or of the machine's bounds (a vessel's path keeps those by construction), else the
-    /// printer or the contour.
+    /// printer, the contour, the control lines or the texture.
     #[test]
     fn a_refusal_advises_by_what_broke() {
         for what in [NOT_CONTINUOUS, RETRACTION, OUTSIDE] {
@@ -168,6 +168,7 @@ mod tests {
             "layer too thin",
         ] {
             assert!(advice(what).contains("finer bead"), "{what}");
+            assert!(advice(what).contains("gentler control lines"), "{what}");
         }
     }
 
