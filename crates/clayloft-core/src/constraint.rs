@@ -221,13 +221,17 @@ fn clamp_point(
     let q = below[NEAR_COLUMNS];
     let dz = (p.z - q.z).max(0.0);
     let limit = dz * tan_limit;
-    let offset = (p.truncate() - q.truncate()).dot(n);
-    let mut excess = None;
-    let mut xy = p.truncate();
-    if offset.abs() > limit {
-        excess = Some(offset.abs() - limit);
-        xy -= n * ((offset.abs() - limit) * offset.signum());
-    }
+    // A point brought back along the normal onto the limit, and by how much it was past it.
+    let onto_limit = |xy: DVec2| {
+        let offset = (xy - q.truncate()).dot(n);
+        let over = offset.abs() - limit;
+        if over > 0.0 {
+            (xy - n * (over * offset.signum()), Some(over))
+        } else {
+            (xy, None)
+        }
+    };
+    let (mut xy, mut excess) = onto_limit(p.truncate());
     // Within the limit of q itself, the wall below is nearer still: most points.
     if (xy - q.truncate()).length_squared() > limit * limit {
         // The nearest point of the wall below, and whether it is an end of `below`.
@@ -243,14 +247,10 @@ fn clamp_point(
         let (d, x, at_end) = nearest;
         if !at_end && d > limit {
             excess = Some(excess.unwrap_or(0.0) + d - limit);
-            xy = x + (xy - x) * (limit / d);
             // Towards a side that turns outward (a concave corner) that can lean the point
             // past the limit along the normal again: the normal's limit holds (the surface's
             // lean is measured along it).
-            let offset = (xy - q.truncate()).dot(n);
-            if offset.abs() > limit {
-                xy -= n * ((offset.abs() - limit) * offset.signum());
-            }
+            xy = onto_limit(x + (xy - x) * (limit / d)).0;
         }
     }
     if enforce && excess.is_some() {

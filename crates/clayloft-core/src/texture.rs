@@ -615,21 +615,6 @@ mod tests {
         }
     }
 
-    /// Segments of a ring that cross another segment of it.
-    fn crossing_segments(ring: &[glam::DVec2]) -> usize {
-        let n = ring.len();
-        let seg = |i: usize| (ring[i], ring[(i + 1) % n]);
-        (0..n)
-            .filter(|&i| {
-                (0..n).any(|j| {
-                    let near = j == i || (j + 1) % n == i || (i + 1) % n == j;
-                    let ((a0, a1), (b0, b1)) = (seg(i), seg(j));
-                    !near && crate::geometry::segments_intersect(a0, a1, b0, b1)
-                })
-            })
-            .count()
-    }
-
     /// A texture deeper than a sharp tip is wide (1.8 mm inward, or a zig-zag of ±1.4 mm every
     /// other point, on the tips of a four-pointed star 60 or 200 points round) makes the
     /// points beside each tip change places: the ring crosses itself there. Faded where it
@@ -653,11 +638,12 @@ mod tests {
             let raw: Vec<glam::DVec2> = (0..n)
                 .map(|i| before[1].points[i].truncate() + normals[i] * disp[1][i])
                 .collect();
-            assert!(crossing_segments(&raw) > 0, "{n}: the test needs a fold");
+            let crossing = crate::geometry::find_self_intersection;
+            assert!(crossing(&raw).is_some(), "{n}: the test needs a fold");
             let mut after = before.clone();
             let lowered = apply_displacements(&mut after, &disp, 1e9, true);
             assert!(lowered.overhang.is_empty(), "{n}");
-            assert_eq!(crossing_segments(&ring(&after[1])), 0, "{n}");
+            assert_eq!(crossing(&ring(&after[1])), None, "{n}");
             assert!(!lowered.folds.is_empty(), "{n}");
             assert!(
                 lowered.folds.len() < n / 2,
