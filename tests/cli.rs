@@ -566,6 +566,102 @@ fn output_into_a_closed_pipe_is_quiet() {
 }
 
 /// Hostile numbers: violations (exit 1) or bad input (exit 2), never a hang.
+/// Found by random designs (2026-12-06, seed 409): control lines pushing a star's tips
+/// through the wall above, clamped back by the overhang limit, left the path looping up to
+/// 4 mm across at 19 places, with every other limit holding. The self-check refuses it now.
+#[test]
+fn a_path_that_crosses_itself_is_refused_and_check_says_where() {
+    let dir = tempfile::tempdir().unwrap();
+    let design = dir.path().join("looping.toml");
+    std::fs::write(
+        &design,
+        r#"version = 1
+name = "random 409"
+[printer]
+layer_height = 1.0
+[shape]
+height = 91.2
+samples = 120
+base_layers = 3
+[shape.lower]
+type = "star"
+points = 6
+outer_radius = 67.44
+inner_radius = 43.19
+[shape.upper]
+type = "rose"
+radius = 37.67
+amplitude = 3.34
+petals = 4
+[[control.vertical]]
+points = [[0.0, 0.0], [0.17, 7.5], [0.73, 8.7], [0.88, -13.3], [1.0, 0.0]]
+angle = 71.7
+width = 34.8
+[[control.vertical]]
+points = [[0.0, 0.0], [0.28, 1.5], [1.0, 0.0]]
+[texture]
+combine = "product"
+y = { wave = "sine", period = 14, amplitude = 0.71 }
+x = { wave = "sine", period = 9, amplitude = 2.79 }
+"#,
+    )
+    .unwrap();
+    let g = dir.path().join("looping.gcode");
+    let out = clayloft(&["gcode", design.to_str().unwrap(), "-o", g.to_str().unwrap()]);
+    assert_bad_input(
+        &out,
+        &[
+            "looping.toml",
+            "path crosses itself",
+            "mm out from the crossing",
+        ],
+    );
+    assert!(!g.exists());
+
+    // A hand-made spiral, 30 mm round, 0.5 mm a turn, that swings 5 mm out and back over
+    // itself once a turn (a prolate cycloid's loop): one loop a turn, reaching 4–5 mm from
+    // where it crosses (half the default 3 mm bead is 1.5 mm).
+    let mut gcode = String::from("G21\nG90\nM83\nG0 X130 Y95 Z1\n");
+    let (turns, n) = (4, 200);
+    for k in 1..=turns * n {
+        let t = k as f64 / n as f64;
+        let a = std::f64::consts::TAU * t;
+        let (radial, tangent) = ((a.cos(), a.sin()), (-a.sin(), a.cos()));
+        let f = (t.fract() - 0.3) / 0.06;
+        let (out, back) = if (0.0..1.0).contains(&f) {
+            let phase = std::f64::consts::TAU * f;
+            (2.5 * (1.0 - phase.cos()), 6.0 * phase.sin())
+        } else {
+            (0.0, 0.0)
+        };
+        let r = 30.0 + out;
+        let x = 100.0 + r * radial.0 + back * tangent.0;
+        let y = 95.0 + r * radial.1 + back * tangent.1;
+        gcode += &format!("G1 X{x:.3} Y{y:.3} Z{:.3} E0.5\n", 1.0 + 0.5 * t);
+    }
+    let file = dir.path().join("loops.gcode");
+    std::fs::write(&file, gcode).unwrap();
+    let out = clayloft(&["check", file.to_str().unwrap()]);
+    let report = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{report}");
+    let line = report
+        .lines()
+        .find(|l| l.starts_with("VIOLATION path crosses itself"))
+        .unwrap_or_else(|| panic!("{report}"));
+    assert!(line.contains(": 4 moves, worst 4."), "{line}");
+    // The first loop closes in the first turn's loop (points 60 … 72, lines 65 … 77).
+    let first: usize = line
+        .split("first at line ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((65..=77).contains(&first), "{line}");
+}
+
 #[test]
 fn check_is_bounded_whatever_the_numbers() {
     let dir = tempfile::tempdir().unwrap();

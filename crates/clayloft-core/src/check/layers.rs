@@ -8,8 +8,10 @@ use foldhash::fast::FixedState;
 use glam::{DVec2, DVec3};
 
 use super::Limits;
+use super::crossings::{CrossingLimits, LOOP_REACH_BEADS, find_crossings};
 use super::report::{
-    COLLISION, CheckReport, NOT_MEASURED, OVERHANG, PathEvent, Tally, UNSUPPORTED, Violation,
+    COLLISION, CROSSING, CheckReport, NOT_MEASURED, OVERHANG, PathEvent, Tally, UNSUPPORTED,
+    Violation,
 };
 use crate::geometry::point_segment_distance;
 
@@ -190,7 +192,7 @@ impl Run {
 
 /// The first index of `v` where `pred` is false (`pred` true on a prefix of `v`, false after),
 /// stepping from `guess` when it is near and bisecting otherwise.
-fn seek<T>(v: &[T], guess: usize, pred: impl Fn(&T) -> bool) -> usize {
+pub(super) fn seek<T>(v: &[T], guess: usize, pred: impl Fn(&T) -> bool) -> usize {
     const STEPS: usize = 8;
     let mut i = guess.min(v.len());
     for _ in 0..STEPS {
@@ -582,16 +584,25 @@ fn measure_layers_in(
         radius
     };
     let (chords, cum) = chords_and_lengths(v);
+    let usable = |id: usize| {
+        let (a, b) = (v[chords[id].0], v[chords[id].1]);
+        inside(a) && inside(b) && !steep(a, b)
+    };
+    let crossings = find_crossings(
+        v,
+        &chords,
+        lines,
+        &cum,
+        CrossingLimits {
+            same_layer: below_tol,
+            half_bead: 0.5 * limits.line_width,
+            reach: LOOP_REACH_BEADS * limits.line_width,
+        },
+        &usable,
+    );
     let index = match search {
         // The tree holds what the grid holds, and is never too large to build.
-        Search::Tree => Some(ChordIndex::Tree(ChordTree::build(
-            v,
-            &chords,
-            &|id: usize| {
-                let (a, b) = (v[chords[id].0], v[chords[id].1]);
-                inside(a) && inside(b) && !steep(a, b)
-            },
-        ))),
+        Search::Tree => Some(ChordIndex::Tree(ChordTree::build(v, &chords, &usable))),
         // Columns twice the near box's half-width across: a point's near box spans 2 × 2 of
         // them mostly. Every chord goes into the grid first; a point's candidates are the
         // chords that end at or before it (a prefix of each column's ascending list), so the
@@ -753,6 +764,15 @@ fn measure_layers_in(
         " mm high (z of the highest such point)",
         format!("no printed layer within {radius:.1} mm below"),
     );
+    push(
+        crossings.tally,
+        CROSSING,
+        " mm out from the crossing",
+        format!(
+            "the nozzle runs through the bead it laid in the same layer, in loops reaching more than half a bead ({} mm) from where the path crosses itself",
+            0.5 * limits.line_width
+        ),
+    );
     report.max_rise_above_tip = clearance.max_rise;
     push(
         clearance.collide,
@@ -763,6 +783,18 @@ fn measure_layers_in(
             limits.nozzle_length
         ),
     );
+    if !crossings.complete {
+        report.violations.push(Violation {
+            what: NOT_MEASURED,
+            count: 1,
+            worst: report.path_length_mm,
+            unit: " mm of path",
+            first_line: lines[0],
+            detail: "the path turns back on itself too often in too small a space: where it crosses itself was not searched in full".into(),
+        });
+    }
+    report.events.extend(crossings.events);
+    report.events.sort_by_key(|e| e.line);
     shown
 }
 

@@ -18,6 +18,7 @@
 //! whether the limits hold, and shows most points' layers by a witness instead;
 //! [`GcodeVerifier`] is `verify_gcode` of a program read as it is written.
 
+mod crossings;
 mod layers;
 mod limits;
 mod moves;
@@ -30,8 +31,8 @@ use moves::MoveReader;
 pub use moves::{GcodeError, Move, parse_moves};
 use report::Tally;
 pub use report::{
-    COLLISION, CheckReport, NOT_CONTINUOUS, NOT_MEASURED, OUTSIDE, OVERHANG, PathEvent, RETRACTION,
-    UNSUPPORTED, Violation,
+    COLLISION, CROSSING, CheckReport, NOT_CONTINUOUS, NOT_MEASURED, OUTSIDE, OVERHANG, PathEvent,
+    RETRACTION, UNSUPPORTED, Violation,
 };
 
 /// Re-measures a G-code program against `limits`. Errors only when the text is not G-code.

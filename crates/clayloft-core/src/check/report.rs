@@ -68,6 +68,8 @@ pub const OUTSIDE: &str = "outside the machine";
 /// What a move without extrusion between the first and last extruding move is called in
 /// reports.
 pub const NOT_CONTINUOUS: &str = "not one continuous path";
+/// What the path crossing itself within its layer is called in reports.
+pub const CROSSING: &str = "path crosses itself";
 /// What a move that draws the paste back is called in reports.
 pub const RETRACTION: &str = "retraction";
 

@@ -1,0 +1,731 @@
+//! The path crossing itself within its layer: two stretches of the extruding path at the same
+//! height whose XY segments cross. The nozzle drives through the bead it has just laid and
+//! leaves a knot of clay where the wall should run once (a texture or a control line folding a
+//! sharp turn of the wall back on itself). A loop that reaches no farther than half a bead from
+//! its crossing stays within the bead and is let be.
+//!
+//! "The same height" is within a quarter of the minimum layer height (what the layer search
+//! does not take as a layer below), and "its layer" is the stretch of path since it was last
+//! that much lower, at most [`LOOP_REACH_BEADS`] bead widths long: on a spiral, a part of one
+//! revolution.
+//!
+//! **The search.** A chord's window is the stretch of earlier chords it may cross. Testing
+//! every pair would cost the window's length per chord; two facts of plane curves leave most
+//! chords untested, and most of the rest tested against a few:
+//!
+//! * the innermost loop of a crossing is a simple closed polygon: its turns add up to a whole
+//!   turn, of which the turn at the crossing is less than a half-turn, so **the chords from
+//!   one crossing chord to the other turn through more than a half-turn** (the range of their
+//!   unwrapped direction, in [`pseudo_angle`]'s units);
+//! * **a stretch that goes on round a point, less than once round, cannot cross itself**: its
+//!   chords lie in sectors round the point that do not overlap. Round the middle of the path
+//!   (a vessel's axis, roughly) a wall goes on round except where its texture or its outline
+//!   turns back.
+//!
+//! So chord c is tested only against the earlier chords i of its window such that the chords
+//! i ..= c turn through more than a half-turn and do not all go on round. A wall's texture
+//! swings its direction, but on a clay vessel few windows hold both.
+//!
+//! The chords are judged in blocks on every core; each block reads the path back as far as its
+//! first chord's window reaches, so the loops found do not depend on the number of cores.
+
+use glam::{DVec2, DVec3};
+
+use super::report::{CROSSING, PathEvent, Tally};
+
+/// Path, in bead widths, within which a crossing is searched for behind each chord: the
+/// layer's stretch on a spiral is mostly shorter (a loop longer than it rises a quarter
+/// layer, and its crossing is a layer too thin, the layer search's); on a file of flat layers
+/// it bounds the search.
+pub(super) const LOOP_REACH_BEADS: f64 = 50.0;
+
+/// Exact pair tests allowed (with the chords read again before each block): a fixed allowance
+/// shared by the blocks plus this many per chord. A clay spiral tests a few per chord; a file
+/// that piles its path up in one spot runs out, and says so rather than testing for minutes.
+const TESTS_PER_CHORD: usize = 1024;
+const TESTS_BASE: usize = 1 << 22;
+
+/// Chords judged in a block (see the module's documentation).
+const BLOCK: usize = 8192;
+
+/// Chords whose boxes are joined, a pair's very first test.
+const GROUP: usize = 16;
+
+/// The loops found: their tally (each loop's reach from its crossing, mm, at the G-code line
+/// where the path closes it), one event per loop in path order, whether the search ran to the
+/// end, and how many pairs of chords it tested.
+pub(super) struct Crossings {
+    pub(super) tally: Tally,
+    pub(super) events: Vec<PathEvent>,
+    pub(super) complete: bool,
+    pub(super) tested: usize,
+}
+
+/// What [`find_crossings`] measures against.
+#[derive(Clone, Copy)]
+pub(super) struct CrossingLimits {
+    /// Heights closer than this are the same layer, mm.
+    pub(super) same_layer: f64,
+    /// Loops reaching farther than this from their crossing count, mm.
+    pub(super) half_bead: f64,
+    /// How far back along the path a crossing is searched for, mm.
+    pub(super) reach: f64,
+}
+
+/// The loops of path `v`, given as chords (`chords[c]` = points `i ..= k`, nearly straight;
+/// `usable(c)`: the chord is measured, inside the machine and not steep) with each point's
+/// G-code line in `lines` and the path's length up to each point in `cum`.
+pub(super) fn find_crossings(
+    v: &[DVec3],
+    chords: &[(usize, usize)],
+    lines: &[usize],
+    cum: &[f64],
+    limits: CrossingLimits,
+    usable: &(impl Fn(usize) -> bool + Sync),
+) -> Crossings {
+    let n = chords.len();
+    let blocks = n.div_ceil(BLOCK);
+    let path = Path {
+        v,
+        chords,
+        cum,
+        limits,
+        usable,
+    };
+    let judged = crate::parallel::map_ranges(blocks, 2, |range| {
+        let mut work = Work::default();
+        range
+            .map(|b| {
+                let budget = TESTS_BASE.div_ceil(blocks.max(1))
+                    + TESTS_PER_CHORD * (BLOCK.min(n - b * BLOCK));
+                work.judge(&path, b * BLOCK..((b + 1) * BLOCK).min(n), budget)
+            })
+            .collect()
+    });
+    let mut found = Crossings {
+        tally: Tally::default(),
+        events: Vec::new(),
+        complete: true,
+        tested: 0,
+    };
+    for block in judged {
+        found.tested += block.tested;
+        found.complete &= block.complete;
+        for (value, c) in block.loops {
+            let line = lines[chords[c].1];
+            found.tally.add(value, line);
+            found.events.push(PathEvent {
+                line,
+                what: CROSSING,
+                value,
+            });
+        }
+    }
+    found
+}
+
+/// What the blocks read.
+struct Path<'a, U> {
+    v: &'a [DVec3],
+    chords: &'a [(usize, usize)],
+    cum: &'a [f64],
+    limits: CrossingLimits,
+    usable: &'a U,
+}
+
+/// One block's loops (their reach, mm, and the chord closing each), its tests, and whether
+/// it was judged within its budget.
+struct Judged {
+    loops: Vec<(f64, usize)>,
+    tested: usize,
+    complete: bool,
+}
+
+/// A thread's buffers for its blocks, kept from one to the next: each block's chords from the
+/// first its windows reach, indexed from there.
+#[derive(Default)]
+struct Work {
+    boxes: Vec<ChordBox>,
+    /// The boxes of the chords `GROUP` by `GROUP` (the last group's so far).
+    groups: Vec<ChordBox>,
+    /// Unwrapped direction.
+    turn: Vec<f64>,
+    /// Times the path has crossed the ray from the block's middle towards +x, anticlockwise
+    /// less clockwise, by each chord's end: with the angle there, the unwrapped angle round
+    /// the middle.
+    winding: Vec<i32>,
+    /// The first chord of each one's window, and the least start from each chord on, where
+    /// the heights do not rise along the block (else found as the chords are read).
+    starts: Vec<usize>,
+    flag_starts: Vec<usize>,
+    minima: Vec<u32>,
+    highs: MonotoneQueue,
+    lows: MonotoneQueue,
+}
+
+impl Work {
+    /// The loops closed by the chords `block`.
+    fn judge<U: Fn(usize) -> bool>(
+        &mut self,
+        path: &Path<U>,
+        block: std::ops::Range<usize>,
+        mut budget: usize,
+    ) -> Judged {
+        let Path {
+            v,
+            chords,
+            cum,
+            limits,
+            usable,
+        } = *path;
+        let mut judged = Judged {
+            loops: Vec::new(),
+            tested: 0,
+            complete: true,
+        };
+        // The first chord any window of the block may reach.
+        let reach_from = cum[chords[block.start].0] - limits.reach;
+        let first = chords[..block.start].partition_point(|&(_, k)| cum[k] < reach_from);
+        let all = first..block.end;
+        if all.len() - block.len() > budget {
+            judged.complete = false;
+            return judged;
+        }
+        budget -= all.len() - block.len();
+        let centre = centre_of(&v[chords[first].0..=chords[block.end - 1].1]);
+        let chord = |c: usize| (v[chords[first + c].0], v[chords[first + c].1]);
+        let count = all.len();
+        let head = block.start - first;
+        // Windows: found as the chords are read where the heights rise (a spiral, flat
+        // layers), else all first.
+        let rising = (1..count).all(|c| {
+            let ((a0, b0), (a1, b1)) = (chord(c - 1), chord(c));
+            a0.z.min(b0.z) <= a1.z.min(b1.z) && a0.z.max(b0.z) <= a1.z.max(b1.z)
+        });
+        if !rising {
+            self.window_starts(path, all.clone());
+        }
+        self.boxes.clear();
+        self.groups.clear();
+        self.turn.clear();
+        self.winding.clear();
+        self.highs.clear();
+        self.lows.clear();
+        let (mut heading, mut last_heading) = (0.0, None);
+        let mut winding = 0;
+        // The last chords that do not go round the middle anticlockwise, and clockwise.
+        let (mut not_ccw, mut not_cw) = (None, None);
+        let (mut height_from, mut length_from) = (0, 0);
+        for c in 0..count {
+            // The chord read: its box, direction, winding and way round.
+            let (a, b) = chord(c);
+            let d = (b - a).truncate();
+            if d != DVec2::ZERO {
+                let p = pseudo_angle(d);
+                if let Some(q) = last_heading {
+                    heading += wrapped(p - q);
+                }
+                last_heading = Some(p);
+            }
+            self.turn.push(heading);
+            let (ra, rb) = (a.truncate() - centre, b.truncate() - centre);
+            // Crossing the ray y = 0, x > 0 (the ends on either side, or leaving it).
+            if (ra.y < 0.0) != (rb.y < 0.0) && ra.x.max(rb.x) > 0.0 {
+                let x = ra.x + (rb.x - ra.x) * (-ra.y / (rb.y - ra.y));
+                if x > 0.0 {
+                    winding += if rb.y >= 0.0 { 1 } else { -1 };
+                }
+            }
+            self.winding.push(winding);
+            let cross = ra.perp_dot(rb);
+            if cross <= 0.0 {
+                not_ccw = Some(c);
+            }
+            if cross >= 0.0 {
+                not_cw = Some(c);
+            }
+            let bx = ChordBox::of(a, b);
+            self.boxes.push(bx);
+            if c % GROUP == 0 {
+                self.groups.push(bx);
+            } else if let Some(g) = self.groups.last_mut() {
+                *g = g.joined(&bx);
+            }
+            let turn = &self.turn;
+            self.highs.push(c, |k| turn[k] <= turn[c]);
+            self.lows.push(c, |k| turn[k] >= turn[c]);
+            // The window.
+            let (start, flag_start) = if rising {
+                let below = bx.lo.z - limits.same_layer;
+                while height_from < c && self.boxes[height_from].hi.z < below {
+                    height_from += 1;
+                }
+                let reach = cum[chords[first + c].0] - limits.reach;
+                while length_from < c && cum[chords[first + length_from].1] < reach {
+                    length_from += 1;
+                }
+                let start = height_from.max(length_from);
+                (start, start)
+            } else {
+                (self.starts[c], self.flag_starts[c])
+            };
+            if c < head {
+                continue;
+            }
+            self.highs.drop_before(flag_start);
+            self.lows.drop_before(flag_start);
+            if c < start + 2 {
+                continue;
+            }
+            // Turning through no more than a half-turn (2 in pseudo-angle units): no loop.
+            if turn[self.highs.first()] - turn[self.lows.first()] <= 2.0 || !usable(first + c) {
+                continue;
+            }
+            // After the last chord that does not go round one way, the chords go round that
+            // way: no loop among them closes at c, unless they go all round.
+            let mut end = c - 1;
+            for last_other in [not_ccw, not_cw] {
+                let after = last_other.map_or(start, |k| (k + 1).max(start));
+                if !self.all_round(chord, centre, after, c) {
+                    end = end.min(last_other.map_or(0, |k| (k + 1).max(start)));
+                }
+            }
+            if end <= start {
+                continue;
+            }
+            if end - start > budget {
+                judged.complete = false;
+                return judged;
+            }
+            let near = bx.widened(limits.same_layer);
+            // A group's box first, then its chords'.
+            let mut i = start;
+            while i < end {
+                let group_end = ((i / GROUP + 1) * GROUP).min(end);
+                budget = budget.saturating_sub(1);
+                judged.tested += 1;
+                if self.groups[i / GROUP].meets(&near) {
+                    for (i, b) in (i..group_end).zip(&self.boxes[i..group_end]) {
+                        budget = budget.saturating_sub(1);
+                        judged.tested += 1;
+                        if !b.meets(&near) || !usable(first + i) {
+                            continue;
+                        }
+                        let (ci, cc) = (chords[first + i], chords[first + c]);
+                        if let Some(reach) = loop_reach(v, ci, cc, limits, &mut budget) {
+                            judged.loops.push((reach, first + c));
+                        }
+                    }
+                }
+                i = group_end;
+            }
+        }
+        judged
+    }
+
+    /// Whether chords `from ..= to` go all round `centre` (their ends' unwrapped angles a
+    /// whole turn apart, or more): never where the winding is the same at both ends.
+    fn all_round(
+        &self,
+        chord: impl Fn(usize) -> (DVec3, DVec3),
+        centre: DVec2,
+        from: usize,
+        to: usize,
+    ) -> bool {
+        let winding_before = from.checked_sub(1).map_or(0, |k| self.winding[k]);
+        if self.winding[to] == winding_before {
+            return false;
+        }
+        let angle = |p: DVec3| pseudo_angle_or_zero(p.truncate() - centre);
+        let turns = f64::from(self.winding[to] - winding_before);
+        (angle(chord(to).1) - angle(chord(from).0) + 4.0 * turns).abs() >= 4.0
+    }
+
+    /// Each chord's window (see [`find_crossings`]) as indices into the block's chords `all`,
+    /// where the heights do not rise along them: the chord after the last one lying wholly a
+    /// layer's tolerance below it (found on the running minima of the chords' tops, stepping
+    /// from the last chord's answer), and no farther back than `limits.reach` of path; and
+    /// the least start from each chord on.
+    fn window_starts<U>(&mut self, path: &Path<U>, all: std::ops::Range<usize>) {
+        let (v, chords, cum, limits) = (path.v, path.chords, path.cum, path.limits);
+        let first = all.start;
+        let heights = |c: usize| {
+            let (a, b) = (v[chords[first + c].0].z, v[chords[first + c].1].z);
+            (a.min(b), a.max(b))
+        };
+        self.starts.clear();
+        self.minima.clear();
+        // Chords whose tops are lower than every later one's, in path order (so rising in
+        // height): the last chord below any height is among them.
+        let (mut guess, mut length_from) = (0, 0);
+        for c in 0..all.len() {
+            let (low, top) = heights(c);
+            let below = low - limits.same_layer;
+            guess = super::layers::seek(&self.minima, guess, |&k| heights(k as usize).1 < below);
+            let by_height = guess
+                .checked_sub(1)
+                .map_or(0, |m| self.minima[m] as usize + 1);
+            let reach = cum[chords[first + c].0] - limits.reach;
+            while length_from < c && cum[chords[first + length_from].1] < reach {
+                length_from += 1;
+            }
+            self.starts.push(by_height.max(length_from));
+            while self
+                .minima
+                .last()
+                .is_some_and(|&k| heights(k as usize).1 >= top)
+            {
+                self.minima.pop();
+            }
+            self.minima.push(c as u32);
+            guess = guess.min(self.minima.len());
+        }
+        self.flag_starts.clear();
+        self.flag_starts.extend_from_slice(&self.starts);
+        for c in (0..all.len().saturating_sub(1)).rev() {
+            self.flag_starts[c] = self.flag_starts[c].min(self.flag_starts[c + 1]);
+        }
+    }
+}
+
+/// A chord's box: a pair's first test, on a compact array.
+#[derive(Clone, Copy)]
+struct ChordBox {
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl ChordBox {
+    fn of(a: DVec3, b: DVec3) -> Self {
+        ChordBox {
+            lo: a.min(b),
+            hi: a.max(b),
+        }
+    }
+
+    fn joined(&self, o: &ChordBox) -> Self {
+        ChordBox {
+            lo: self.lo.min(o.lo),
+            hi: self.hi.max(o.hi),
+        }
+    }
+
+    /// The box with `dz` more room above and below.
+    fn widened(&self, dz: f64) -> Self {
+        ChordBox {
+            lo: self.lo - DVec3::Z * dz,
+            hi: self.hi + DVec3::Z * dz,
+        }
+    }
+
+    /// Whether the boxes overlap (or touch).
+    fn meets(&self, o: &ChordBox) -> bool {
+        (self.lo.x <= o.hi.x)
+            & (self.hi.x >= o.lo.x)
+            & (self.lo.y <= o.hi.y)
+            & (self.hi.y >= o.lo.y)
+            & (self.lo.z <= o.hi.z)
+            & (self.hi.z >= o.lo.z)
+    }
+}
+
+/// `step` (a difference of [`pseudo_angle`]s) as the turn of less than a half-turn each way
+/// it stands for: within −2 … 2.
+fn wrapped(step: f64) -> f64 {
+    if step > 2.0 {
+        step - 4.0
+    } else if step <= -2.0 {
+        step + 4.0
+    } else {
+        step
+    }
+}
+
+/// The middle of the extent in XY of points `v`: a vessel's axis, roughly (nothing depends on
+/// it but how much is tested).
+fn centre_of(v: &[DVec3]) -> DVec2 {
+    let (lo, hi) = v.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p.truncate()), hi.max(p.truncate())),
+    );
+    let c = 0.5 * (lo + hi);
+    if c.is_finite() { c } else { DVec2::ZERO }
+}
+
+/// Whether chords `a` and `b` (`a` earlier) of path `v` cross at the same height, and if so how
+/// far the loop between them reaches from the crossing (its points' greatest XY distance
+/// from it): that reach where it is more than half a bead, else none. The loop's points are
+/// counted against `budget`.
+fn loop_reach(
+    v: &[DVec3],
+    (a0, a1): (usize, usize),
+    (b0, b1): (usize, usize),
+    limits: CrossingLimits,
+    budget: &mut usize,
+) -> Option<f64> {
+    let (p, q) = (v[a0], v[a1]);
+    let (r, s) = (v[b0], v[b1]);
+    let (p2, q2, r2, s2) = (p.truncate(), q.truncate(), r.truncate(), s.truncate());
+    // Boxes apart: no crossing.
+    if p2.x.max(q2.x) < r2.x.min(s2.x)
+        || r2.x.max(s2.x) < p2.x.min(q2.x)
+        || p2.y.max(q2.y) < r2.y.min(s2.y)
+        || r2.y.max(s2.y) < p2.y.min(q2.y)
+    {
+        return None;
+    }
+    // A proper crossing: each segment's ends strictly on either side of the other.
+    let (d, e) = (q2 - p2, s2 - r2);
+    let (r_side, s_side) = (d.perp_dot(r2 - p2), d.perp_dot(s2 - p2));
+    let (p_side, q_side) = (e.perp_dot(p2 - r2), e.perp_dot(q2 - r2));
+    if !(r_side * s_side < 0.0 && p_side * q_side < 0.0) {
+        return None;
+    }
+    // Where: fractions t along a, u along b.
+    let t = p_side / (p_side - q_side);
+    let u = r_side / (r_side - s_side);
+    let (za, zb) = (p.z + (q.z - p.z) * t, r.z + (s.z - r.z) * u);
+    if (za - zb).abs() >= limits.same_layer {
+        return None;
+    }
+    let at = p2 + d * t;
+    let between = &v[a1..=b0];
+    *budget = budget.saturating_sub(between.len());
+    let reach = between
+        .iter()
+        .map(|m| m.truncate().distance_squared(at))
+        .fold(0.0, f64::max)
+        .sqrt();
+    (reach > limits.half_bead).then_some(reach)
+}
+
+/// The direction of `d` (not zero) as a number in 0 … 4 that grows with its angle from +x,
+/// a quarter-turn for each 1 and d's opposite exactly 2 more (mod 4): so a direction turned by
+/// more than a half-turn from another is more than 2 from it, unwrapped. A division instead
+/// of an arctangent.
+fn pseudo_angle(d: DVec2) -> f64 {
+    // y / (|x| + |y|) runs −1 … 1 over the right half-plane; the left half-plane's runs on
+    // from 1 to 3. Written to select, not branch: a textured wall's directions change
+    // quadrant at random.
+    let t = d.y / (d.x.abs() + d.y.abs());
+    let p = if d.x >= 0.0 { t } else { 2.0 - t };
+    if p < 0.0 { p + 4.0 } else { p }
+}
+
+/// [`pseudo_angle`] of `d`, or 0 for the zero vector.
+fn pseudo_angle_or_zero(d: DVec2) -> f64 {
+    if d == DVec2::ZERO {
+        0.0
+    } else {
+        pseudo_angle(d)
+    }
+}
+
+/// Chord indices in path order, the window's running extreme first: a sliding window's
+/// maximum or minimum in constant time per chord.
+#[derive(Default)]
+struct MonotoneQueue {
+    items: Vec<u32>,
+    /// Where the queue begins in `items`.
+    head: usize,
+}
+
+impl MonotoneQueue {
+    fn clear(&mut self) {
+        self.items.clear();
+        self.head = 0;
+    }
+
+    /// Adds chord `c`, dropping the chords behind it that `beaten` says it outdoes.
+    fn push(&mut self, c: usize, beaten: impl Fn(usize) -> bool) {
+        while self.items.len() > self.head && self.items.last().is_some_and(|&k| beaten(k as usize))
+        {
+            self.items.pop();
+        }
+        self.items.push(c as u32);
+    }
+
+    /// Drops the chords before `start` (keeping the last).
+    fn drop_before(&mut self, start: usize) {
+        while self.head + 1 < self.items.len() && (self.items[self.head] as usize) < start {
+            self.head += 1;
+        }
+    }
+
+    /// The window's extreme (the last chord pushed when empty).
+    fn first(&self) -> usize {
+        self.items.get(self.head).map_or(0, |&k| k as usize)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    const LIMITS: CrossingLimits = CrossingLimits {
+        same_layer: 0.0625,
+        half_bead: 0.6,
+        reach: 240.0,
+    };
+
+    /// Every point its own chord, every chord measured.
+    fn search(v: &[DVec3]) -> Crossings {
+        let chords: Vec<(usize, usize)> = (0..v.len() - 1).map(|i| (i, i + 1)).collect();
+        let lines: Vec<usize> = (0..v.len()).collect();
+        let mut cum = vec![0.0];
+        for w in v.windows(2) {
+            cum.push(cum.last().unwrap() + w[0].distance(w[1]));
+        }
+        find_crossings(v, &chords, &lines, &cum, LIMITS, &|_| true)
+    }
+
+    /// A spiral of `turns` revolutions of radius 40 mm, 0.5 mm a revolution, `n` points each,
+    /// with `curl(t)` added to each point (t in revolutions).
+    fn spiral(turns: f64, n: usize, curl: impl Fn(f64) -> DVec2) -> Vec<DVec3> {
+        let count = (turns * n as f64) as usize;
+        (0..=count)
+            .map(|k| {
+                let t = k as f64 / n as f64;
+                let a = TAU * t;
+                let p = DVec2::new(100.0 + 40.0 * a.cos(), 100.0 + 40.0 * a.sin()) + curl(t);
+                p.extend(0.5 + 0.5 * t)
+            })
+            .collect()
+    }
+
+    /// A loop tied into the spiral at revolution `at` of each, `width` revolutions long: the
+    /// wall swings `2 r` mm out and `back` mm back along itself and on (a prolate cycloid's
+    /// arch, which crosses itself where the swing back outruns the ring's way forward).
+    fn curl(at: f64, width: f64, r: f64, back: f64) -> impl Fn(f64) -> DVec2 {
+        move |t| {
+            let f = (t - at).rem_euclid(1.0) / width;
+            if f >= 1.0 {
+                return DVec2::ZERO;
+            }
+            let a = TAU * t;
+            let (radial, tangent) = (DVec2::new(a.cos(), a.sin()), DVec2::new(-a.sin(), a.cos()));
+            let phase = TAU * f;
+            radial * (r * (1.0 - phase.cos())) + tangent * (back * phase.sin())
+        }
+    }
+
+    #[test]
+    fn a_spiral_that_only_turns_one_way_has_no_loop_and_tests_no_pair() {
+        let v = spiral(6.0, 720, |_| DVec2::ZERO);
+        let found = search(&v);
+        assert!(found.events.is_empty());
+        assert!(found.complete);
+        assert_eq!(found.tested, 0);
+        // A wavy wall (a texture: its direction swings ±60° about the ring's) has none either.
+        let v = spiral(6.0, 720, |t| {
+            let a = TAU * t;
+            DVec2::new(a.cos(), a.sin()) * (1.5 * (TAU * 40.0 * t).sin())
+        });
+        let found = search(&v);
+        assert!(found.events.is_empty());
+        assert_eq!(found.tested, 0);
+    }
+
+    #[test]
+    fn a_loop_in_every_revolution_is_found_once_each_with_its_reach() {
+        // A 3 mm loop, a fortieth of a revolution long (6 mm of the 250 mm ring), every turn.
+        let v = spiral(4.0, 720, curl(0.3, 0.05, 3.0, 4.5));
+        let found = search(&v);
+        assert_eq!(found.events.len(), 4, "one loop a revolution");
+        assert!(found.events.iter().all(|e| e.what == CROSSING));
+        // The loop swings 6 mm out; it crosses itself about 1.7 mm out.
+        let worst = found.events.iter().map(|e| e.value).fold(0.0, f64::max);
+        assert!(worst > 3.5 && worst < 6.0, "{worst}");
+        assert_eq!(every_pair(&v), 4);
+    }
+
+    #[test]
+    fn loops_of_any_size_anywhere_are_found_as_testing_every_pair_finds_them() {
+        // A small generator of its own (no seed to keep), loops of 0.2 … 5 mm, some swinging
+        // back too little to cross.
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut looped = 0;
+        for _ in 0..12 {
+            let (at, width) = (next(), 0.02 + 0.06 * next());
+            let (r, back) = (0.1 + 2.4 * next(), 0.5 + 8.0 * next());
+            let v = spiral(3.0, 720, curl(at, width, r, back));
+            let expected = every_pair(&v);
+            looped += usize::from(expected > 0);
+            assert_eq!(search(&v).events.len(), expected, "{at} {width} {r} {back}");
+        }
+        assert!(looped >= 4, "only {looped} of the spirals loop");
+    }
+
+    #[test]
+    fn a_loop_within_half_a_bead_is_let_be() {
+        let v = spiral(3.0, 7200, curl(0.3, 0.01, 0.15, 0.8));
+        assert!(every_pair_raw(&v) > 0, "the path does cross itself");
+        assert!(search(&v).events.is_empty());
+    }
+
+    #[test]
+    fn crossing_the_layer_below_is_not_a_loop() {
+        // A ring that wanders in and out a bead from revolution to revolution crosses the one
+        // below it over and over, a layer lower.
+        let v = spiral(5.0, 360, |t| {
+            let a = TAU * t;
+            DVec2::new(a.cos(), a.sin()) * (1.2 * (TAU * (t * 1.37)).sin())
+        });
+        assert!(search(&v).events.is_empty());
+    }
+
+    #[test]
+    fn the_pseudo_angle_grows_with_the_angle_and_its_opposite_is_two_more() {
+        let mut last = -1.0;
+        for k in 0..3600 {
+            let a = TAU * k as f64 / 3600.0;
+            let d = DVec2::new(a.cos(), a.sin()) * 3.7;
+            let p = pseudo_angle(d);
+            assert!(p > last && (0.0..4.0).contains(&p), "{k}: {p}");
+            last = p;
+            let opposite = (pseudo_angle(-d) - p).rem_euclid(4.0);
+            assert!((opposite - 2.0).abs() < 1e-9, "{k}: {opposite}");
+        }
+    }
+
+    /// Loops found by testing every pair of segments in the same layer with the same rules.
+    fn every_pair(v: &[DVec3]) -> usize {
+        let mut budget = usize::MAX;
+        let mut count = 0;
+        for j in 2..v.len() - 1 {
+            for i in 0..j - 1 {
+                if (v[i].z - v[j].z).abs() < 0.5
+                    && loop_reach(v, (i, i + 1), (j, j + 1), LIMITS, &mut budget).is_some()
+                {
+                    count += 1;
+                }
+            }
+        }
+        count
+    }
+
+    /// Proper crossings of segments at the same height, however small their loops.
+    fn every_pair_raw(v: &[DVec3]) -> usize {
+        let mut budget = usize::MAX;
+        let tiny = CrossingLimits {
+            half_bead: 0.0,
+            ..LIMITS
+        };
+        let mut count = 0;
+        for j in 2..v.len() - 1 {
+            for i in j.saturating_sub(60)..j - 1 {
+                if loop_reach(v, (i, i + 1), (j, j + 1), tiny, &mut budget).is_some() {
+                    count += 1;
+                }
+            }
+        }
+        count
+    }
+}
