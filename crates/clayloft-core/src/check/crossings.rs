@@ -51,9 +51,9 @@ const BLOCK: usize = 8192;
 /// Chords whose boxes are joined, a pair's very first test.
 const GROUP: usize = 16;
 
-/// The loops found: their tally (each loop's reach from its crossing, mm, at the G-code line
-/// where the path closes it), one event per loop in path order, whether the search ran to the
-/// end, and how many pairs of chords it tested.
+/// The loops found: their tally (for each move that closes one or more, the widest one's reach
+/// from its crossing, mm, at that move's G-code line), one event per such move in path order,
+/// whether the search ran to the end, and how many pairs of chords it tested.
 pub(super) struct Crossings {
     pub(super) tally: Tally,
     pub(super) events: Vec<PathEvent>,
@@ -133,8 +133,8 @@ struct Path<'a, U> {
     usable: &'a U,
 }
 
-/// One block's loops (their reach, mm, and the chord closing each), its tests, and whether
-/// it was judged within its budget.
+/// One block's loops (for each chord that closes one or more, the widest one's reach, mm),
+/// its tests, and whether it was judged within its budget.
 struct Judged {
     loops: Vec<(f64, usize)>,
     tested: usize,
@@ -298,7 +298,8 @@ impl Work {
                 return judged;
             }
             let near = bx.widened(limits.same_layer);
-            // A group's box first, then its chords'.
+            // A group's box first, then its chords'. The widest loop c closes, if any.
+            let mut widest: Option<f64> = None;
             let mut i = start;
             while i < end {
                 let group_end = ((i / GROUP + 1) * GROUP).min(end);
@@ -313,11 +314,14 @@ impl Work {
                         }
                         let (ci, cc) = (chords[first + i], chords[first + c]);
                         if let Some(reach) = loop_reach(v, ci, cc, limits, &mut budget) {
-                            judged.loops.push((reach, first + c));
+                            widest = Some(widest.map_or(reach, |w| w.max(reach)));
                         }
                     }
                 }
                 i = group_end;
+            }
+            if let Some(reach) = widest {
+                judged.loops.push((reach, first + c));
             }
         }
         judged
@@ -661,6 +665,22 @@ mod tests {
             assert_eq!(search(&v).events.len(), expected, "{at} {width} {r} {back}");
         }
         assert!(looped >= 4, "only {looped} of the spirals loop");
+        // Textures that swing the wall back along itself and out (trochoids), some enough to
+        // loop at every wave, some short of it: windows of both ways round and of sharp turns.
+        let mut looped = 0;
+        for _ in 0..12 {
+            let waves = (10.0 + 50.0 * next()).round();
+            let (out, along) = (0.3 + 2.0 * next(), 0.5 + 1.5 * next());
+            let v = spiral(3.0, 720, move |t| {
+                let (a, w) = (TAU * t, TAU * waves * t);
+                DVec2::new(a.cos(), a.sin()) * (out * w.cos())
+                    + DVec2::new(-a.sin(), a.cos()) * (along * w.sin())
+            });
+            let expected = every_pair(&v);
+            looped += usize::from(expected > 0);
+            assert_eq!(search(&v).events.len(), expected, "{waves} {out} {along}");
+        }
+        assert!((2..12).contains(&looped), "{looped} of the textures loop");
     }
 
     #[test]
@@ -695,20 +715,18 @@ mod tests {
         }
     }
 
-    /// Loops found by testing every pair of segments in the same layer with the same rules.
+    /// Segments that close a loop, found by testing every pair of segments in the same layer
+    /// with the same rules.
     fn every_pair(v: &[DVec3]) -> usize {
         let mut budget = usize::MAX;
-        let mut count = 0;
-        for j in 2..v.len() - 1 {
-            for i in 0..j - 1 {
-                if (v[i].z - v[j].z).abs() < 0.5
-                    && loop_reach(v, (i, i + 1), (j, j + 1), LIMITS, &mut budget).is_some()
-                {
-                    count += 1;
-                }
-            }
-        }
-        count
+        (2..v.len() - 1)
+            .filter(|&j| {
+                (0..j - 1).any(|i| {
+                    (v[i].z - v[j].z).abs() < 0.5
+                        && loop_reach(v, (i, i + 1), (j, j + 1), LIMITS, &mut budget).is_some()
+                })
+            })
+            .count()
     }
 
     /// Proper crossings of segments at the same height, however small their loops.
