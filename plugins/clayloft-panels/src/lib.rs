@@ -383,14 +383,14 @@ fn replay_panel(ui: &mut egui::Ui, replay: &mut Replay, path: &ReplayPath, plann
     }
     if path.checking {
         ui.label(if replay.active {
-            "checking the path for collisions and overhangs …"
+            "checking the path for collisions, overhangs and loops …"
         } else {
-            "the path is checked for collisions and overhangs when the replay is shown"
+            "the path is checked for collisions, overhangs and loops when the replay is shown"
         });
     } else if path.events.is_empty() {
         ui.colored_label(
             egui::Color32::from_rgb(150, 220, 150),
-            "no collision, overhang or unsupported point on this path",
+            "no collision, overhang, unsupported point or loop on this path",
         );
     } else {
         ui.label(format!(
