@@ -101,7 +101,7 @@ fn offset_section(section: &Section, depth: f64, n: usize) -> Option<Section> {
     if rings.len() != 1 {
         return None;
     }
-    let ring = starting_nearest(&rings.pop()?, xy[0]);
+    let ring = starting_at_step(&rings.pop()?, &xy);
     let ring = resample_closed(&ring, n);
     Some(Section {
         points: ring
@@ -112,22 +112,71 @@ fn offset_section(section: &Section, depth: f64, n: usize) -> Option<Section> {
     })
 }
 
-/// The closed polyline `ring` re-started at its point nearest `p` (inserted on its segment).
-fn starting_nearest(ring: &[DVec2], p: DVec2) -> Vec<DVec2> {
-    let m = ring.len();
-    let (mut best, mut at, mut foot) = (f64::INFINITY, 0, ring[0]);
-    for i in 0..m {
-        let (a, b) = (ring[i], ring[(i + 1) % m]);
-        let (d, f) = crate::geometry::point_segment_distance(p, a, b);
-        if d < best {
-            (best, at, foot) = (d, i, a.lerp(b, f));
-        }
-    }
+/// Feet on the bead's ring tried, nearest first, for a step onto it that crosses nothing (see
+/// [`starting_at_step`]).
+const STEP_CANDIDATES: usize = 24;
+
+/// The closed polyline `ring` (a bead's offset of the outer section `outer`) re-started where
+/// the path steps onto it from the outer section's point 0: the ring's point nearest that point
+/// (inserted on its segment), unless the straight step to it crosses the outer ring or the bead
+/// itself. That happens where point 0 is the tip of a deep texture's crest that leans back
+/// over the flank before it: the nozzle would drive back through the flank it has just laid (a
+/// loop at every layer's seam, found by random designs). Then the nearest foot (of the
+/// [`STEP_CANDIDATES`] nearest segments') whose step crosses neither; the nearest if none.
+fn starting_at_step(ring: &[DVec2], outer: &[DVec2]) -> Vec<DVec2> {
+    let (m, p) = (ring.len(), outer[0]);
+    let feet: Vec<(f64, usize, DVec2)> = (0..m)
+        .map(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % m]);
+            let (d, f) = crate::geometry::point_segment_distance(p, a, b);
+            (d, i, a.lerp(b, f))
+        })
+        .collect();
+    let nearest = feet
+        .iter()
+        .copied()
+        .min_by(|x, y| x.0.total_cmp(&y.0))
+        .expect("a ring has segments");
+    let (_, at, foot) = if step_is_clear(p, nearest.2, nearest.1, ring, outer) {
+        nearest
+    } else {
+        let mut order = feet;
+        order.sort_by(|x, y| x.0.total_cmp(&y.0));
+        order
+            .into_iter()
+            .take(STEP_CANDIDATES)
+            .find(|&(_, i, f)| step_is_clear(p, f, i, ring, outer))
+            .unwrap_or(nearest)
+    };
     let mut out = Vec::with_capacity(m + 1);
     out.push(foot);
     out.extend((1..=m).map(|s| ring[(at + s) % m]));
     // The vertex after the foot may coincide with it; drop a zero-length first step.
     crate::geometry::dedup_closed(&out)
+}
+
+/// Whether the step from `outer[0]` to `foot` (on segment `at` of `ring`) crosses no segment of
+/// the closed polylines `outer` and `ring` (touching where it starts and ends aside).
+fn step_is_clear(p: DVec2, foot: DVec2, at: usize, ring: &[DVec2], outer: &[DVec2]) -> bool {
+    let (lo, hi) = (p.min(foot), p.max(foot));
+    let crosses = |a: DVec2, b: DVec2| {
+        if a.max(b).cmplt(lo).any() || a.min(b).cmpgt(hi).any() {
+            return false;
+        }
+        let d = foot - p;
+        let (s_a, s_b) = (d.perp_dot(a - p), d.perp_dot(b - p));
+        let e = b - a;
+        let (s_p, s_f) = (e.perp_dot(p - a), e.perp_dot(foot - a));
+        s_a * s_b < 0.0 && s_p * s_f < 0.0
+    };
+    let n = outer.len();
+    // The outer ring's segments, but the two that meet at point 0.
+    let outer_clear = (1..n - 1).all(|i| !crosses(outer[i], outer[i + 1]));
+    let m = ring.len();
+    outer_clear
+        && (0..m)
+            .filter(|&i| i != at)
+            .all(|i| !crosses(ring[i], ring[(i + 1) % m]))
 }
 
 /// Moves the points of a bead's section outward along its normal by `amplitude · tri(N·i/n)`,

@@ -111,3 +111,47 @@ x = { wave = "triangle", period = 4, amplitude = 1.41 }
         );
     }
 }
+
+/// Found by random designs (2026-12-06, seed 177): a two-bead wall with a square wave 2.77 mm
+/// deep. Where the outer bead's point 0 is a crest's tip that leans back over the flank before
+/// it, the straight step to the inner bead's nearest point crossed that flank: a loop reaching
+/// 3.4 mm at the seam of five layers, which the checker now refuses. The step now lands on the
+/// nearest point of the inner bead it reaches without crossing anything.
+#[test]
+fn a_two_bead_seam_steps_inward_without_crossing_a_deep_texture() {
+    let design = clayloft_core::load::parse_design(
+        r#"
+version = 1
+name = "random 177"
+[printer]
+layer_height = 0.5
+[shape]
+height = 84.8
+samples = 120
+base_layers = 3
+walls = 2
+[shape.lower]
+type = "spline"
+points = [[41.92, 8.11], [18.31, 13.91], [10.13, 43.89], [-24.45, 19.30], [-31.43, 1.72], [-16.18, -30.10], [6.09, -31.94], [17.93, -13.67]]
+[shape.upper]
+type = "circle"
+radius = 48.96
+[texture]
+combine = "sum"
+x = { wave = "square", period = 6, amplitude = 2.77 }
+"#,
+    )
+    .unwrap();
+    let job = clayloft_core::run(&design).unwrap();
+    let points: Vec<glam::DVec3> = job.toolpath.points.iter().map(|q| q.pos).collect();
+    assert_eq!(looping_segments(&points, 1.6, 60), 0);
+    let limits = clayloft_core::check::Limits::from(&design.printer);
+    let report = clayloft_core::check::check_path(&points, &limits);
+    assert!(
+        !report
+            .violations
+            .iter()
+            .any(|v| v.what == clayloft_core::check::CROSSING),
+        "{report}"
+    );
+}
