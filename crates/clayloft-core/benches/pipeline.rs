@@ -187,7 +187,7 @@ fn gcode_writing(c: &mut Criterion) {
             metrics: Default::default(),
             point_leans_deg: Vec::new(),
         }),
-        beads: std::sync::Arc::new(Vec::new()),
+        beads: std::sync::Arc::default(),
         verdict: None,
         toolpath: std::sync::Arc::new(Toolpath {
             points,

@@ -40,7 +40,7 @@ pub struct Surface {
 pub struct PrintJob {
     pub surface: Arc<Surface>,
     /// The wall's inner beads ([`crate::walls::inner_beads`]): empty for a one-bead wall.
-    pub beads: Arc<Vec<Vec<Section>>>,
+    pub beads: Arc<crate::walls::InnerBeads>,
     pub toolpath: Arc<Toolpath>,
     /// Whether the wet wall stands while the toolpath is printed (SPEC §14); `None` for a clay
     /// body that does not resolve (validation reports it).
@@ -48,9 +48,14 @@ pub struct PrintJob {
 }
 
 impl PrintJob {
-    /// Everything the stages corrected or found, the surface's first, then the path's.
+    /// Everything the stages corrected or found: the surface's first, then the inner beads',
+    /// then the path's.
     pub fn findings(&self) -> impl Iterator<Item = &Finding> {
-        self.surface.findings.iter().chain(&self.toolpath.findings)
+        self.surface
+            .findings
+            .iter()
+            .chain(&self.beads.findings)
+            .chain(&self.toolpath.findings)
     }
 }
 

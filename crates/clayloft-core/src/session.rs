@@ -169,6 +169,10 @@ pub struct BeadKey {
     pub line_width: f64,
     /// From which section the inner beads are tied (none: untied).
     pub ties_from: Option<usize>,
+    /// The overhang limit they are held to (its tangent, margin included), and whether it is
+    /// enforced or only reported.
+    pub tan_limit: f64,
+    pub enforce: bool,
 }
 
 /// Inputs of the spiral toolpath.
@@ -224,7 +228,7 @@ struct LaterStages {
     texture: Stage<TextureKey, Vec<Vec<f64>>>,
     surface: Stage<SurfaceKey, Arc<Surface>>,
     base: Stage<BaseKey, Vec<crate::base_fill::BaseFill>>,
-    beads: Stage<BeadKey, Arc<Vec<Vec<Section>>>>,
+    beads: Stage<BeadKey, Arc<crate::walls::InnerBeads>>,
     toolpath: Stage<ToolpathKey, Arc<Toolpath>>,
     /// Whether the wet wall stands while the toolpath is printed (`None` for a clay body that
     /// does not resolve: validation reports it).
@@ -606,7 +610,7 @@ impl Session {
     }
 
     /// The wall's inner beads, `[j − 1][k]` bead `j`'s section `k` (empty for a one-bead wall).
-    pub fn beads(&self) -> Option<&Arc<Vec<Vec<Section>>>> {
+    pub fn beads(&self) -> Option<&Arc<crate::walls::InnerBeads>> {
         self.later.beads.get()
     }
 
@@ -760,6 +764,8 @@ fn finish_stages(
         walls: design.shape.walls,
         line_width: p.line_width,
         ties_from: crate::toolpath::ties_from(design, &surface),
+        tan_limit: crate::pipeline::overhang_tan_limit(design),
+        enforce: design.constraints.enforce,
     };
     done.beads = later.beads.refresh(key, || {
         crate::toolpath::inner_beads(design, &surface).map(Arc::new)

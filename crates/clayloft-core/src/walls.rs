@@ -24,6 +24,24 @@ use crate::pipeline::Surface;
 use crate::section::Section;
 use crate::validate::FieldError;
 
+/// The inner beads of a wall as printed: `sections[j − 1][k]` is bead `j`'s section `k`
+/// ([`inner_beads`], each clamped to the overhang limit against itself a layer below where the
+/// outer bead's corners sharpen), and what that clamp corrected (or, with the limits not
+/// enforced, found) for the report. Reads as its sections.
+#[derive(Debug, Clone, Default)]
+pub struct InnerBeads {
+    pub sections: Vec<Vec<Section>>,
+    pub findings: Vec<crate::report::Finding>,
+}
+
+impl std::ops::Deref for InnerBeads {
+    type Target = Vec<Vec<Section>>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.sections
+    }
+}
+
 /// Most beads side by side a wall may have.
 pub const MAX_WALLS: usize = 3;
 

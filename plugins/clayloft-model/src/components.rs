@@ -69,7 +69,7 @@ pub struct VesselMesh(pub Arc<clayloft_core::view_mesh::WallBuffers>);
 /// The wall's inner beads (SPEC §13), on the vessel entity: `[j − 1][k]` is bead `j`'s section
 /// `k`; empty for a one-bead wall.
 #[derive(Component, Debug, Clone, Default)]
-pub struct VesselBeads(pub Arc<Vec<Vec<Section>>>);
+pub struct VesselBeads(pub Arc<clayloft_core::walls::InnerBeads>);
 
 impl VesselBeads {
     /// The innermost bead's sections, if the wall has more than one bead.
