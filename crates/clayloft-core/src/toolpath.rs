@@ -99,6 +99,10 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
     build_toolpath_on(design, surface, &fills, &beads.sections)
 }
 
+/// How far, in bead widths, the overhang clamp may move an inner bead towards the bead outside
+/// it (see [`inner_beads`]): less than half a bead, so that it never lies on that bead.
+const MAX_BEAD_CLAMP_BEADS: f64 = 0.4;
+
 /// The inner beads of the design's wall ([`crate::walls::inner_beads`]); empty for one bead.
 ///
 /// Each bead is then held to the overhang limit against itself a layer below, like the outer
@@ -106,7 +110,9 @@ pub fn build_toolpath(design: &Design, surface: &Surface) -> Result<Toolpath, Fi
 /// bead or two, and where a corner of the outer wall sharpens from layer to layer the inner
 /// corner, a bead's width over the sine of half its angle from the outer one, moves faster
 /// than the outer corner does (random designs: two-bead walls leaning 48° at one point with
-/// the outer wall within 45°). There the bead presses a little into the one outside it.
+/// the outer wall within 45°). There the bead presses a little into the one outside it: at
+/// most [`MAX_BEAD_CLAMP_BEADS`] of a bead (further, and it would lie on the outer bead, a
+/// layer too thin, or cross it; the bead is then left unclamped, for the checker to judge).
 pub fn inner_beads(
     design: &Design,
     surface: &Surface,
@@ -125,13 +131,29 @@ pub fn inner_beads(
     let enforce = design.constraints.enforce;
     let tan_limit = crate::pipeline::overhang_tan_limit(design);
     let limit = design.printer.max_overhang_deg;
-    let findings = sections
-        .iter_mut()
-        .enumerate()
-        .flat_map(|(j, bead)| {
-            let events = crate::constraint::clamp_overhang(bead, 1, tan_limit, enforce);
-            crate::report::group_events(&events, FindingKind::Overhang, enforce, 3, |mm| {
-                let which = ["second", "third"][j.min(1)];
+    let most = MAX_BEAD_CLAMP_BEADS * design.printer.line_width;
+    let mut findings = Vec::new();
+    for (j, bead) in sections.iter_mut().enumerate() {
+        let mut clamped = bead.clone();
+        let events = crate::constraint::clamp_overhang(&mut clamped, 1, tan_limit, enforce);
+        // Pressed into the bead outside it by more than that, the bead is left where its
+        // offset puts it, for the checker to judge (as before the clamp).
+        let moved = |(a, b): (&Section, &Section)| {
+            a.points
+                .iter()
+                .zip(&b.points)
+                .any(|(p, q)| p.truncate().distance_squared(q.truncate()) > most * most)
+        };
+        if enforce && clamped.iter().zip(bead.iter()).any(moved) {
+            continue;
+        }
+        let which = ["second", "third"][j.min(1)];
+        findings.extend(crate::report::group_events(
+            &events,
+            FindingKind::Overhang,
+            enforce,
+            3,
+            |mm| {
                 if enforce {
                     format!(
                         "the wall's {which} bead leaned past {limit}° at a corner sharpening from layer to layer; clamped by up to {mm:.2} mm"
@@ -139,9 +161,10 @@ pub fn inner_beads(
                 } else {
                     format!("the wall's {which} bead leans past {limit}° by up to {mm:.2} mm per layer")
                 }
-            })
-        })
-        .collect();
+            },
+        ));
+        *bead = clamped;
+    }
     Ok(crate::walls::InnerBeads { sections, findings })
 }
 
