@@ -912,6 +912,43 @@ x = { wave = "square", period = 18, amplitude = 1.71 }
         );
     }
 
+    /// Random design 180: a rose narrowing to a small circle, two beads. Its inner bead leans
+    /// past the clamp's limit where the rose's valleys close up, and holding it there moved it
+    /// 4.9 mm, through the outer bead (a layer too thin: refused). The clamp leaves a bead it
+    /// would press more than 0.4 bead into the outer one, and the design prints as it did.
+    #[test]
+    fn an_inner_bead_is_never_clamped_onto_the_bead_outside_it() {
+        let d = parse_design(
+            r#"version = 1
+[printer]
+layer_height = 0.5
+[shape]
+height = 30.4
+samples = 60
+base_layers = 2
+walls = 2
+[shape.lower]
+type = "rose"
+radius = 41.98
+amplitude = 10.07
+petals = 4
+[shape.upper]
+type = "circle"
+radius = 15.35
+[[control.horizontal]]
+at = 1.0
+reach = 0.27
+points = [[0.0, 0.0], [90.0, 6.1], [180.0, 0.0], [270.0, 1.8]]
+"#,
+        )
+        .unwrap();
+        let job = run(&d).unwrap();
+        let points: Vec<DVec3> = job.toolpath.points.iter().map(|q| q.pos).collect();
+        let report = crate::check::check_path(&points, &crate::check::Limits::from(&d.printer));
+        assert!(report.ok(), "{report}");
+        assert!(job.beads.findings.is_empty(), "{:?}", job.beads.findings);
+    }
+
     #[test]
     fn min_layer_time_slows_small_layers() {
         let d = design("[printer]\nmin_layer_time = 30.0\n");
