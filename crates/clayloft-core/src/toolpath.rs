@@ -111,7 +111,7 @@ const MAX_BEAD_CLAMP_BEADS: f64 = 0.4;
 /// corner, a bead's width over the sine of half its angle from the outer one, moves faster
 /// than the outer corner does (random designs: two-bead walls leaning 48° at one point with
 /// the outer wall within 45°). There the bead presses a little into the one outside it: at
-/// most [`MAX_BEAD_CLAMP_BEADS`] of a bead (further, and it would lie on the outer bead, a
+/// most 0.4 of a bead (`MAX_BEAD_CLAMP_BEADS`) (further, and it would lie on the outer bead, a
 /// layer too thin, or cross it; the bead is then left unclamped, for the checker to judge).
 pub fn inner_beads(
     design: &Design,
@@ -863,6 +863,15 @@ mod tests {
         }
     }
 
+    /// The job of `d`, its toolpath having passed the checker.
+    fn run_and_check(d: &Design) -> crate::PrintJob {
+        let job = run(d).unwrap();
+        let points: Vec<DVec3> = job.toolpath.points.iter().map(|q| q.pos).collect();
+        let report = crate::check::check_path(&points, &crate::check::Limits::from(&d.printer));
+        assert!(report.ok(), "{report}");
+        job
+    }
+
     /// Found by random designs (2026-12-06, seed 130): an ellipse lofted to a rounded heptagon,
     /// two beads, its wall clamped at 45° nearly all the way up. The inner bead, the outer one
     /// moved a bead inward, lies a bead over the sine of half the corner's angle inside the
@@ -900,10 +909,7 @@ x = { wave = "square", period = 18, amplitude = 1.71 }
 "#,
         )
         .unwrap();
-        let job = run(&d).unwrap();
-        let points: Vec<DVec3> = job.toolpath.points.iter().map(|q| q.pos).collect();
-        let report = crate::check::check_path(&points, &crate::check::Limits::from(&d.printer));
-        assert!(report.ok(), "{report}");
+        let job = run_and_check(&d);
         assert!(
             job.findings()
                 .any(|f| f.corrected && f.message.contains("second bead leaned past 45°")),
@@ -942,10 +948,7 @@ points = [[0.0, 0.0], [90.0, 6.1], [180.0, 0.0], [270.0, 1.8]]
 "#,
         )
         .unwrap();
-        let job = run(&d).unwrap();
-        let points: Vec<DVec3> = job.toolpath.points.iter().map(|q| q.pos).collect();
-        let report = crate::check::check_path(&points, &crate::check::Limits::from(&d.printer));
-        assert!(report.ok(), "{report}");
+        let job = run_and_check(&d);
         assert!(job.beads.findings.is_empty(), "{:?}", job.beads.findings);
     }
 

@@ -721,19 +721,26 @@ fn measure_layers_in(
     if !report.min_layer_height.is_finite() {
         report.min_layer_height = 0.0;
     }
-    if !measurable {
+    // A search that gave up, and what it left unmeasured.
+    let not_measured = |report: &mut CheckReport, detail: String| {
         report.violations.push(Violation {
             what: NOT_MEASURED,
             count: 1,
             worst: report.path_length_mm,
             unit: " mm of path",
             first_line: lines[0],
-            detail: format!(
+            detail,
+        })
+    };
+    if !measurable {
+        not_measured(
+            report,
+            format!(
                 "segments hundreds of bead widths long ({:.0} mm of path in {} chords): layers, overhang and support were not measured",
                 report.path_length_mm,
                 chords.len()
             ),
-        });
+        );
     }
     let mut push = |t: Tally, what: &'static str, unit: &'static str, detail: String| {
         report
@@ -784,14 +791,10 @@ fn measure_layers_in(
         ),
     );
     if !crossings.complete {
-        report.violations.push(Violation {
-            what: NOT_MEASURED,
-            count: 1,
-            worst: report.path_length_mm,
-            unit: " mm of path",
-            first_line: lines[0],
-            detail: "the path turns back on itself too often in too small a space: where it crosses itself was not searched in full".into(),
-        });
+        not_measured(
+            report,
+            "the path turns back on itself too often in too small a space: where it crosses itself was not searched in full".into(),
+        );
     }
     report.events.extend(crossings.events);
     report.events.sort_by_key(|e| e.line);
