@@ -22,9 +22,11 @@
 //!   (a vessel's axis, roughly) a wall goes on round except where its texture or its outline
 //!   turns back.
 //!
-//! So chord c is tested only against the earlier chords i of its window such that the chords
-//! i ..= c turn through more than a half-turn and do not all go on round. A wall's texture
-//! swings its direction, but on a clay vessel few windows hold both.
+//! So chord c is tested only where its window turns through more than a half-turn, and then
+//! only against the earlier chords i such that the chords i ..= c go both ways round (or all
+//! the way round); a group of 16 chords' box is tested before theirs. On the benchmark vase a
+//! quarter of the windows pass the first test (its textured belly, its base's rings), and
+//! about one pair in a chord is tested.
 //!
 //! The chords are judged in blocks on every core; each block reads the path back as far as its
 //! first chord's window reaches, so the loops found do not depend on the number of cores.
