@@ -10,7 +10,7 @@ use std::path::Path;
 
 use crate::atomic::{Replaced, WriteError};
 use crate::check::{
-    CheckReport, GcodeError, GcodeVerifier, Limits, NOT_CONTINUOUS, OUTSIDE, RETRACTION,
+    CROSSING, CheckReport, GcodeError, GcodeVerifier, Limits, NOT_CONTINUOUS, OUTSIDE, RETRACTION,
 };
 use crate::design::Design;
 use crate::gcode::{JobSummary, write_gcode_summarized};
@@ -55,6 +55,10 @@ fn advice(what: &str) -> &'static str {
         "the printer's start or end G-code travels or retracts between extruding moves (a purge line?): leave that out of it"
     } else if what == OUTSIDE {
         "the printer's start or end G-code moves outside the machine, or the vessel does not fit it"
+    } else if what == CROSSING {
+        // A finer bead would make it stricter (the loop is let be within half a bead), and
+        // thinner layers do not change it: the shape folds the path.
+        "the wall turns back on itself there: gentler control lines, a shallower texture or one of a longer period, or a rounder contour where the wall turns sharply (its corrections, in `clayloft info` or the app's Constraints panel, say where the shape had to change)"
     } else {
         "try a printer with a finer bead or thinner layers, or a simpler contour, gentler control lines or a shallower texture (its corrections, in `clayloft info` or the app's Constraints panel, say where the shape had to change)"
     }
@@ -170,6 +174,9 @@ mod tests {
             assert!(advice(what).contains("finer bead"), "{what}");
             assert!(advice(what).contains("gentler control lines"), "{what}");
         }
+        // A loop: the shape, not the printer.
+        let loops = advice(CROSSING);
+        assert!(!loops.contains("finer bead") && loops.contains("shallower texture"));
     }
 
     /// A refusal says how far the worst point is past the limit, in the limit's own unit: a
