@@ -39,7 +39,7 @@ pub const MAX_RING_LEVELS: usize = 1000;
 /// At most how many rings deep a foot's fill goes: half its smaller extent over the bead width
 /// (no ring lies deeper), plus one.
 pub fn ring_levels(foot: &[DVec2], w: f64) -> usize {
-    let (lo, hi) = crate::geometry::bounds(foot);
+    let (lo, hi) = crate::geometry::bounds(foot.iter().copied());
     let levels = ((hi - lo).min_element() / 2.0 / w).ceil();
     if levels.is_finite() {
         levels.min(1e9) as usize + 1
@@ -833,7 +833,7 @@ pub struct Coverage {
 
 /// The [`Coverage`] of `path` over `foot` (see there).
 pub fn coverage(path: &[DVec2], foot: &[DVec2], w: f64, cell: f64) -> Coverage {
-    let (lo, hi) = crate::geometry::bounds(foot);
+    let (lo, hi) = crate::geometry::bounds(foot.iter().copied());
     let (lo, hi) = (lo - w, hi + w);
     let nx = ((hi.x - lo.x) / cell).ceil() as usize;
     let ny = ((hi.y - lo.y) / cell).ceil() as usize;

@@ -108,6 +108,21 @@ pub fn segments_intersect(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> bool {
     on(b0, a0, a1, d1) || on(b1, a0, a1, d2) || on(a0, b0, b1, d3) || on(a1, b0, b1, d4)
 }
 
+/// Where segments `a0–a1` and `b0–b1` cross properly (each one's ends strictly on either side
+/// of the other; touching and collinear overlaps are not crossings): the fractions `(t, u)`
+/// along each, the crossing being `a0 + t·(a1 − a0) = b0 + u·(b1 − b0)`. Their boxes first,
+/// which rules out most pairs.
+pub fn proper_crossing(a0: DVec2, a1: DVec2, b0: DVec2, b1: DVec2) -> Option<(f64, f64)> {
+    if a0.max(a1).cmplt(b0.min(b1)).any() || b0.max(b1).cmplt(a0.min(a1)).any() {
+        return None;
+    }
+    let (da, db) = (a1 - a0, b1 - b0);
+    let (b0_side, b1_side) = (da.perp_dot(b0 - a0), da.perp_dot(b1 - a0));
+    let (a0_side, a1_side) = (db.perp_dot(a0 - b0), db.perp_dot(a1 - b0));
+    (b0_side * b1_side < 0.0 && a0_side * a1_side < 0.0)
+        .then(|| (a0_side / (a0_side - a1_side), b0_side / (b0_side - b1_side)))
+}
+
 /// Finds a pair of non-adjacent segments of a closed polyline that intersect, if any.
 ///
 /// Sweep over x: segments sorted by their left end, an active list pruned by right end. For the
@@ -212,10 +227,10 @@ pub fn normal_from_neighbours(before: DVec2, after: DVec2) -> DVec2 {
 }
 
 /// The smallest and largest x and y of a set of points (their bounding box's corners).
-pub fn bounds(points: &[DVec2]) -> (DVec2, DVec2) {
-    points.iter().fold(
+pub fn bounds(points: impl IntoIterator<Item = DVec2>) -> (DVec2, DVec2) {
+    points.into_iter().fold(
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
     )
 }
 
@@ -394,6 +409,22 @@ mod tests {
         (0..n)
             .map(|i| DVec2::from_angle(TAU * i as f64 / n as f64) * r)
             .collect()
+    }
+
+    /// A proper crossing gives where along each segment; touching at an end, running along
+    /// the other or missing it is no crossing.
+    #[test]
+    fn a_proper_crossing_and_where_it_lies() {
+        let v = |x, y| DVec2::new(x, y);
+        let (t, u) = proper_crossing(v(0.0, 0.0), v(4.0, 0.0), v(1.0, -1.0), v(1.0, 3.0)).unwrap();
+        assert!(
+            (t - 0.25).abs() < 1e-12 && (u - 0.25).abs() < 1e-12,
+            "{t} {u}"
+        );
+        assert!(proper_crossing(v(0.0, 0.0), v(4.0, 0.0), v(4.0, 0.0), v(5.0, 1.0)).is_none());
+        assert!(proper_crossing(v(0.0, 0.0), v(4.0, 0.0), v(1.0, 0.0), v(3.0, 0.0)).is_none());
+        assert!(proper_crossing(v(0.0, 0.0), v(4.0, 0.0), v(5.0, -1.0), v(5.0, 1.0)).is_none());
+        assert!(proper_crossing(v(0.0, 0.0), v(4.0, 0.0), v(2.0, 0.0), v(2.0, 1.0)).is_none());
     }
 
     #[test]

@@ -176,17 +176,7 @@ fn starting_at_step(ring: &[DVec2], outer: &[DVec2]) -> Vec<DVec2> {
 /// Whether the step from `outer[0]` to `foot` (on segment `at` of `ring`) crosses no segment of
 /// the closed polylines `outer` and `ring` (touching where it starts and ends aside).
 fn step_is_clear(p: DVec2, foot: DVec2, at: usize, ring: &[DVec2], outer: &[DVec2]) -> bool {
-    let (lo, hi) = (p.min(foot), p.max(foot));
-    let crosses = |a: DVec2, b: DVec2| {
-        if a.max(b).cmplt(lo).any() || a.min(b).cmpgt(hi).any() {
-            return false;
-        }
-        let d = foot - p;
-        let (s_a, s_b) = (d.perp_dot(a - p), d.perp_dot(b - p));
-        let e = b - a;
-        let (s_p, s_f) = (e.perp_dot(p - a), e.perp_dot(foot - a));
-        s_a * s_b < 0.0 && s_p * s_f < 0.0
-    };
+    let crosses = |a: DVec2, b: DVec2| crate::geometry::proper_crossing(p, foot, a, b).is_some();
     let n = outer.len();
     // The outer ring's segments, but the two that meet at point 0.
     let outer_clear = (1..n - 1).all(|i| !crosses(outer[i], outer[i + 1]));

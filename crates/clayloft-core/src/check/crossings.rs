@@ -135,6 +135,19 @@ struct Path<'a, U> {
     usable: &'a U,
 }
 
+impl<U> Path<'_, U> {
+    /// The first of a block's chords (counted from chord `first`) that ends within
+    /// `limits.reach` of path before chord `c` starts, stepping on from `from` (the answer for
+    /// an earlier chord; the chords' ends only move on).
+    fn length_start(&self, first: usize, c: usize, from: &mut usize) -> usize {
+        let reach = self.cum[self.chords[first + c].0] - self.limits.reach;
+        while *from < c && self.cum[self.chords[first + *from].1] < reach {
+            *from += 1;
+        }
+        *from
+    }
+}
+
 /// One block's loops (for each chord that closes one or more, the widest one's reach, mm),
 /// its tests, and whether it was judged within its budget.
 struct Judged {
@@ -262,11 +275,7 @@ impl Work {
                 while height_from < c && self.boxes[height_from].hi.z < below {
                     height_from += 1;
                 }
-                let reach = cum[chords[first + c].0] - limits.reach;
-                while length_from < c && cum[chords[first + length_from].1] < reach {
-                    length_from += 1;
-                }
-                let start = height_from.max(length_from);
+                let start = height_from.max(path.length_start(first, c, &mut length_from));
                 (start, start)
             } else {
                 (self.starts[c], self.flag_starts[c])
@@ -353,7 +362,7 @@ impl Work {
     /// from the last chord's answer), and no farther back than `limits.reach` of path; and
     /// the least start from each chord on.
     fn window_starts<U>(&mut self, path: &Path<U>, all: std::ops::Range<usize>) {
-        let (v, chords, cum, limits) = (path.v, path.chords, path.cum, path.limits);
+        let (v, chords, limits) = (path.v, path.chords, path.limits);
         let first = all.start;
         let heights = |c: usize| {
             let (a, b) = (v[chords[first + c].0].z, v[chords[first + c].1].z);
@@ -371,11 +380,8 @@ impl Work {
             let by_height = guess
                 .checked_sub(1)
                 .map_or(0, |m| self.minima[m] as usize + 1);
-            let reach = cum[chords[first + c].0] - limits.reach;
-            while length_from < c && cum[chords[first + length_from].1] < reach {
-                length_from += 1;
-            }
-            self.starts.push(by_height.max(length_from));
+            self.starts
+                .push(by_height.max(path.length_start(first, c, &mut length_from)));
             while self
                 .minima
                 .last()
@@ -450,10 +456,7 @@ fn wrapped(step: f64) -> f64 {
 /// The middle of the extent in XY of points `v`: a vessel's axis, roughly (nothing depends on
 /// it but how much is tested).
 fn centre_of(v: &[DVec3]) -> DVec2 {
-    let (lo, hi) = v.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(p.truncate()), hi.max(p.truncate())),
-    );
+    let (lo, hi) = crate::geometry::bounds(v.iter().map(|p| p.truncate()));
     let c = 0.5 * (lo + hi);
     if c.is_finite() { c } else { DVec2::ZERO }
 }
@@ -471,30 +474,13 @@ fn loop_reach(
 ) -> Option<f64> {
     let (p, q) = (v[a0], v[a1]);
     let (r, s) = (v[b0], v[b1]);
-    let (p2, q2, r2, s2) = (p.truncate(), q.truncate(), r.truncate(), s.truncate());
-    // Boxes apart: no crossing.
-    if p2.x.max(q2.x) < r2.x.min(s2.x)
-        || r2.x.max(s2.x) < p2.x.min(q2.x)
-        || p2.y.max(q2.y) < r2.y.min(s2.y)
-        || r2.y.max(s2.y) < p2.y.min(q2.y)
-    {
-        return None;
-    }
-    // A proper crossing: each segment's ends strictly on either side of the other.
-    let (d, e) = (q2 - p2, s2 - r2);
-    let (r_side, s_side) = (d.perp_dot(r2 - p2), d.perp_dot(s2 - p2));
-    let (p_side, q_side) = (e.perp_dot(p2 - r2), e.perp_dot(q2 - r2));
-    if !(r_side * s_side < 0.0 && p_side * q_side < 0.0) {
-        return None;
-    }
-    // Where: fractions t along a, u along b.
-    let t = p_side / (p_side - q_side);
-    let u = r_side / (r_side - s_side);
+    let (t, u) =
+        crate::geometry::proper_crossing(p.truncate(), q.truncate(), r.truncate(), s.truncate())?;
     let (za, zb) = (p.z + (q.z - p.z) * t, r.z + (s.z - r.z) * u);
     if (za - zb).abs() >= limits.same_layer {
         return None;
     }
-    let at = p2 + d * t;
+    let at = p.truncate().lerp(q.truncate(), t);
     let between = &v[a1..=b0];
     *budget = budget.saturating_sub(between.len());
     let reach = between
