@@ -243,13 +243,7 @@ mod tests {
     /// the origin (some star-shaped, some winding twice, some folding back, some off centre),
     /// and the pentagram {5/2} and a bow tie are refused.
     fn outlines_passing_the_star_test_never_cross() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_rng::uniform(0x2545_f491_4f6c_dd1d);
         let mut passed = 0;
         for _ in 0..2000 {
             let n = 3 + (next() * 30.0) as usize;

@@ -54,6 +54,8 @@ pub mod spline;
 pub mod stl;
 pub mod svg;
 pub mod templates;
+#[cfg(test)]
+mod test_rng;
 pub mod texture;
 pub mod thumbnail;
 pub mod toolpath;

@@ -634,15 +634,8 @@ mod tests {
 
     #[test]
     fn loops_of_any_size_anywhere_are_found_as_testing_every_pair_finds_them() {
-        // A small generator of its own (no seed to keep), loops of 0.2 … 5 mm, some swinging
-        // back too little to cross.
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        // Loops of 0.2 … 5 mm, some swinging back too little to cross.
+        let mut next = crate::test_rng::uniform(0x2545_f491_4f6c_dd1d);
         let mut looped = 0;
         for _ in 0..12 {
             let (at, width) = (next(), 0.02 + 0.06 * next());
