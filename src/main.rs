@@ -394,6 +394,14 @@ fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, F
         move || drop(replaced),
         || print_summary(&loaded, &job, Some(written.summary)),
     );
+    if !written.unenforced.is_empty() {
+        println!(
+            "the checker finds in this G-code (constraints not enforced: written as designed):"
+        );
+        for v in &written.unenforced {
+            println!("  {v}");
+        }
+    }
     println!("wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
 }

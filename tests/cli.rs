@@ -153,6 +153,85 @@ fn enforcement_off_reports_violations_and_check_exits_1() {
         "{}",
         text(&check.stdout)
     );
+    // `gcode` says what `check` of its file says, line for line.
+    assert_checker_said(&out, &check);
+}
+
+/// Every violation `check` (its output `check`) reports is in `gcode`'s output `gcode`, under
+/// the line that says the checker found it.
+fn assert_checker_said(gcode: &Output, check: &Output) {
+    let said = text(&gcode.stdout);
+    let (_, found) = said
+        .split_once("the checker finds in this G-code (constraints not enforced")
+        .unwrap_or_else(|| panic!("{said}"));
+    let violations: Vec<_> = text(&check.stdout)
+        .lines()
+        .filter(|l| l.starts_with("VIOLATION"))
+        .map(str::to_string)
+        .collect();
+    assert!(!violations.is_empty());
+    for v in violations {
+        assert!(found.contains(&format!("  {v}\n")), "{v} in {said}");
+    }
+}
+
+/// With enforcement off, a path that loops through its own bead (random design 38: a star
+/// foot, a rose rim, two control lines and a deep triangle texture) is written as designed, and
+/// `gcode` says where it crosses itself: only the checker measures that.
+#[test]
+fn enforcement_off_reports_the_loops_only_the_checker_sees() {
+    let dir = tempfile::tempdir().unwrap();
+    let design = dir.path().join("loops.toml");
+    std::fs::write(
+        &design,
+        r#"version = 1
+name = "random 38"
+[printer]
+layer_height = 1.0
+[shape]
+height = 74.7
+samples = 60
+base_layers = 0
+[shape.lower]
+type = "star"
+points = 12
+outer_radius = 37.50
+inner_radius = 27.46
+[shape.upper]
+type = "rose"
+radius = 35.67
+amplitude = 3.81
+petals = 7
+[[control.vertical]]
+points = [[0.0, 0.0], [0.33, 24.6], [0.74, 1.0], [0.89, -11.6], [1.0, 0.0]]
+angle = 157.2
+width = 44.6
+[[control.vertical]]
+points = [[0.0, 0.0], [0.39, 6.5], [0.67, 23.4], [1.0, 0.0]]
+[[control.horizontal]]
+at = 0.5
+reach = 0.08
+points = [[0.0, 0.0], [90.0, -3.5], [180.0, 0.0], [270.0, -3.3]]
+[texture]
+combine = "product"
+y = { wave = "triangle", period = 16, amplitude = 2.75 }
+x = { wave = "triangle", period = 11, amplitude = 1.98 }
+[constraints]
+enforce = false
+"#,
+    )
+    .unwrap();
+    let g = dir.path().join("loops.gcode");
+    let out = clayloft(&["gcode", design.to_str().unwrap(), "-o", g.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains("VIOLATION path crosses itself: "),
+        "{}",
+        text(&out.stdout)
+    );
+    let check = clayloft(&["check", g.to_str().unwrap()]);
+    assert_eq!(check.status.code(), Some(1));
+    assert_checker_said(&out, &check);
 }
 
 #[test]

@@ -27,6 +27,16 @@ fn pipeline(c: &mut Criterion) {
             black_box(job.toolpath.points.len())
         })
     });
+    // What `clayloft gcode` does in its process: the same, with the self-check of the program
+    // on its way to the disk (the body's moves as the writer tells them).
+    g.bench_function("design_to_checked_gcode_file_720x300", |b| {
+        b.iter(|| {
+            let design = parse_design(BIG_DESIGN).unwrap();
+            let job = clayloft_core::run(&design).unwrap();
+            let written = clayloft_core::export::write_checked_gcode(&design, &job, &out).unwrap();
+            black_box(written.summary.points)
+        })
+    });
     // The same vessel with a two-bead wall (issue 13): the inner bead offset per section, twice
     // the path.
     let two_beads = BIG_DESIGN.replace("[shape]\n", "[shape]\nwalls = 2\n");

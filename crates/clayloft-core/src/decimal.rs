@@ -81,6 +81,16 @@ impl Line {
     /// `decimals` is at most [`MAX_DECIMALS`].
     #[inline]
     pub fn fixed(&mut self, v: f64, decimals: u32) -> &mut Self {
+        self.fixed_read(v, decimals);
+        self
+    }
+
+    /// [`Line::fixed`], giving the number its text reads as ([`decimal_prefix`]'s reading, to
+    /// the bit: the digits n written are n / 10^decimals, one correctly rounded division, as the
+    /// reader makes of them), or None where the number is not written as a plain decimal (not
+    /// finite, or past the integers formatted here).
+    #[inline]
+    pub fn fixed_read(&mut self, v: f64, decimals: u32) -> Option<f64> {
         match decimals {
             0 => self.fixed_const::<0>(v),
             1 => self.fixed_const::<1>(v),
@@ -93,21 +103,23 @@ impl Line {
         }
     }
 
-    /// [`Line::fixed`] with the decimals known to the compiler.
+    /// [`Line::fixed_read`] with the decimals known to the compiler.
     #[inline]
-    fn fixed_const<const D: u32>(&mut self, v: f64) -> &mut Self {
+    fn fixed_const<const D: u32>(&mut self, v: f64) -> Option<f64> {
         let pow = 10u64.pow(D);
         let x = v.abs() * pow as f64;
         // Out of range for integer formatting (never for a real printer), or not a number.
         if !x.is_finite() || x >= 9.0e18 {
-            return self.text(format!("{v:.*}", D as usize).as_bytes());
+            self.text(format!("{v:.*}", D as usize).as_bytes());
+            return None;
         }
         // `x.round()` (half away from zero) without the library call the baseline x86-64 target
         // makes of it: below 2⁵³ the fraction `x − ⌊x⌋` is exact, above it x is whole.
         // Through i64 (x < 2⁶³): one conversion instruction each way.
         let whole = x as i64;
         let n = (whole + i64::from(x - whole as f64 >= 0.5)) as u64;
-        if v < 0.0 && n != 0 {
+        let negative = v < 0.0 && n != 0;
+        if negative {
             self.text(b"-");
         }
         let int = n / pow;
@@ -134,7 +146,13 @@ impl Line {
                 self.digits(frac, D as usize);
             }
         }
-        self
+        // The reader's fast path takes up to 19 digits below 2⁵³ (as the standard parser
+        // would read more, it is left to it: None).
+        if n >= 1 << 53 {
+            return None;
+        }
+        let read = n as f64 / EXACT_POWERS[D as usize];
+        Some(if negative { -read } else { read })
     }
 
     /// Appends the first `width` (at most 4) bytes of `word`, lowest first.
@@ -307,6 +325,33 @@ mod tests {
                 words.push_str(&fixed_by_round(v, d));
             }
             proptest::prop_assert_eq!(std::str::from_utf8(line.as_bytes()).unwrap(), words);
+        }
+
+        /// The number a text is told to read as is what the reader and the standard parser
+        /// read, to the bit (zero's sign too), on any number, halves, and values near the
+        /// limits; where none is told, the text is not a plain decimal the fast path reads.
+        #[test]
+        fn the_number_told_is_the_number_read(
+            v in proptest::num::f64::ANY,
+            small in -1.0e7f64..1.0e7,
+            half in -1_000_000i64..1_000_000,
+            d in 0u32..=MAX_DECIMALS,
+        ) {
+            let edge = 2f64.powi(53) / 10f64.powi(d as i32);
+            for x in [v, small, -small * 1e-7, half as f64 + 0.5, (half as f64 + 0.5) / 10f64.powi(d as i32), edge, edge.next_down(), -0.0, 9.0e18] {
+                let mut line = Line::new();
+                let told = line.fixed_read(x, d);
+                let text = std::str::from_utf8(line.as_bytes()).unwrap();
+                let read = decimal_prefix(line.as_bytes()).filter(|&(_, used)| used == text.len());
+                match told {
+                    Some(t) => {
+                        let (r, _) = read.expect("a plain decimal");
+                        proptest::prop_assert_eq!(t.to_bits(), r.to_bits(), "{} with {} decimals: {}", x, d, text);
+                        proptest::prop_assert_eq!(t.to_bits(), text.parse::<f64>().unwrap().to_bits());
+                    }
+                    None => proptest::prop_assert!(read.is_none(), "{} with {} decimals: {}", x, d, text),
+                }
+            }
         }
     }
 

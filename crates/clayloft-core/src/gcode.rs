@@ -25,6 +25,28 @@ pub const CLEARANCE: f64 = 10.0;
 /// Key of the header line that carries the printer limits for `clayloft check`.
 pub const LIMITS_KEY: &str = "; clayloft-limits:";
 
+/// Where a program goes as it is written: its text and, for a reader of moves that wants them
+/// (the self-check of `clayloft gcode`), each piece of the path's body with the moves its
+/// lines read as, so that the reader need not read that text again.
+pub(crate) trait ProgramOut {
+    /// Text outside the body (header, start G-code, approach, exit, end G-code).
+    fn text(&mut self, bytes: &[u8]) -> io::Result<()>;
+    /// Whether the body's pieces should come with their moves.
+    fn wants_moves(&self) -> bool {
+        false
+    }
+    /// Pieces of the body in order, each with its moves where told.
+    fn body(&mut self, pieces: &[crate::check::ToldPiece<'_>]) -> io::Result<()> {
+        pieces.iter().try_for_each(|p| self.text(p.text))
+    }
+}
+
+impl<W: Write + ?Sized> ProgramOut for W {
+    fn text(&mut self, bytes: &[u8]) -> io::Result<()> {
+        self.write_all(bytes)
+    }
+}
+
 /// Summary of a written (or writable) job.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JobSummary {
@@ -288,7 +310,16 @@ pub fn write_gcode_summarized(
 pub fn write_program(
     design: &Design,
     job: &PrintJob,
-    out: &mut dyn Write,
+    mut out: &mut dyn Write,
+) -> Result<JobSummary, GcodeWriteError> {
+    write_program_indexed(design, job, &mut out, None)
+}
+
+/// [`write_program`] to a [`ProgramOut`], which may take the body's moves as told.
+pub(crate) fn write_program_to(
+    design: &Design,
+    job: &PrintJob,
+    out: &mut dyn ProgramOut,
 ) -> Result<JobSummary, GcodeWriteError> {
     write_program_indexed(design, job, out, None)
 }
@@ -352,7 +383,7 @@ fn mark(index: &mut Option<&mut Vec<u32>>, lines: usize, point: usize) {
 fn write_program_indexed(
     design: &Design,
     job: &PrintJob,
-    out: &mut dyn Write,
+    out: &mut dyn ProgramOut,
     mut index: Option<&mut Vec<u32>>,
 ) -> Result<JobSummary, GcodeWriteError> {
     let p = &design.printer;
@@ -508,7 +539,7 @@ fn write_program_indexed(
         "G90\n{}\nG92 E0 ; positions and E as the path needs them",
         p.extrusion.gcode()
     );
-    out.write_all(head.as_bytes())?;
+    out.text(head.as_bytes())?;
     mark(&mut index, head.matches('\n').count(), 0);
 
     let [ox, oy] = p.origin_offset();
@@ -533,7 +564,7 @@ fn write_program_indexed(
         buf.push(b'\n');
         mark(&mut index, 3, 0);
     }
-    out.write_all(&buf)?;
+    out.text(&buf)?;
     buf.clear();
     let body = BodyWriter::new(
         design,
@@ -557,7 +588,7 @@ fn write_program_indexed(
         buf.push(b'\n');
     }
     buf.extend_from_slice(b"; end\n");
-    out.write_all(&buf)?;
+    out.text(&buf)?;
     Ok(summary)
 }
 
@@ -637,18 +668,21 @@ impl<'a> BodyWriter<'a> {
     }
 
     /// Writes points 1 .. n, chunk by chunk, two chunks at a time in parallel.
-    fn write(&self, out: &mut dyn Write, index: &mut Option<&mut Vec<u32>>) -> io::Result<()> {
+    fn write(&self, out: &mut dyn ProgramOut, index: &mut Option<&mut Vec<u32>>) -> io::Result<()> {
         let n = self.tp.points.len();
         if n < 2 {
             return Ok(());
         }
         let threads = crate::parallel::cores().clamp(1, 2);
         let mut state = BodyState::START;
-        let want_index = index.is_some();
+        let want = Wanted {
+            index: index.is_some(),
+            moves: out.wants_moves(),
+        };
         // Chunks of equal size, so that the threads finish together.
         let chunk = (n - 1).div_ceil(threads).clamp(1, BODY_CHUNK);
-        // The two chunks' text and line marks, reused round after round.
-        let mut bufs = [(Vec::new(), Vec::new()), (Vec::new(), Vec::new())];
+        // The two chunks' pieces, reused round after round.
+        let mut pieces = [Piece::default(), Piece::default()];
         let mut start = 1;
         while start < n {
             // The ranges of this round. Each starts from the state the one before it leaves:
@@ -660,7 +694,7 @@ impl<'a> BodyWriter<'a> {
                 .map(|s| s..(s + chunk).min(n))
                 .collect();
             let (last, others) = ranges.split_last().expect("a chunk or more");
-            let [buf_a, buf_b] = &mut bufs;
+            let [piece_a, piece_b] = &mut pieces;
             let used = match others {
                 // Two chunks: the first on a helper while this thread adds up its sums for the
                 // second, then formats the second.
@@ -668,17 +702,17 @@ impl<'a> BodyWriter<'a> {
                     let first_state = state;
                     crate::parallel::both(
                         n >= 4096,
-                        || self.format(first.clone(), first_state, want_index, buf_a),
+                        || self.format(first.clone(), first_state, want, piece_a),
                         || {
                             state = self.advance(state, first.clone());
-                            self.format(last.clone(), state, want_index, buf_b)
+                            self.format(last.clone(), state, want, piece_b)
                         },
                     );
-                    &bufs[..]
+                    &pieces[..]
                 }
                 [] => {
-                    self.format(last.clone(), state, want_index, buf_a);
-                    &bufs[..1]
+                    self.format(last.clone(), state, want, piece_a);
+                    &pieces[..1]
                 }
                 _ => unreachable!("at most two chunks a round"),
             };
@@ -686,11 +720,17 @@ impl<'a> BodyWriter<'a> {
                 state = self.advance(state, last.clone());
             }
             start = last.end;
-            for (text, lines) in used {
-                out.write_all(text)?;
-                if let Some(v) = index.as_deref_mut() {
-                    v.extend_from_slice(lines);
-                }
+            let told: Vec<_> = used
+                .iter()
+                .map(|p| crate::check::ToldPiece {
+                    text: &p.text,
+                    moves: p.told.then_some(&p.moves[..]),
+                    lines: p.lines,
+                })
+                .collect();
+            out.body(&told)?;
+            if let Some(v) = index.as_deref_mut() {
+                used.iter().for_each(|p| v.extend_from_slice(&p.points));
             }
         }
         Ok(())
@@ -720,24 +760,34 @@ impl<'a> BodyWriter<'a> {
         st
     }
 
-    /// Formats points `range` starting from `st` into `buf` (emptied first); with `want_index`,
-    /// each line's path point into `lines`.
+    /// Formats points `range` starting from `st` into `piece` (emptied first), with what is
+    /// wanted besides the text.
     fn format(
         &self,
         range: std::ops::Range<usize>,
         mut st: BodyState,
-        want_index: bool,
-        (buf, lines): &mut (Vec<u8>, Vec<u32>),
+        want: Wanted,
+        piece: &mut Piece,
     ) {
         let (p, tp) = (&self.design.printer, self.tp);
         let [ox, oy] = self.origin;
-        buf.clear();
-        lines.clear();
-        buf.reserve(range.len() * 48);
+        piece.clear(range.len());
+        if want.moves {
+            piece.moves.reserve(range.len());
+        }
+        let Piece {
+            text: buf,
+            lines,
+            points,
+            moves,
+            told,
+        } = piece;
         let mut line = Line::new();
-        let mark = |lines: &mut Vec<u32>, count: usize, point: usize| {
-            if want_index {
-                lines.extend(std::iter::repeat_n(point as u32, count));
+        // Counts `count` lines at path point `point`.
+        let mark = |lines: &mut usize, points: &mut Vec<u32>, count: usize, point: usize| {
+            *lines += count;
+            if want.index {
+                points.extend(std::iter::repeat_n(point as u32, count));
             }
         };
         for i in range {
@@ -748,7 +798,7 @@ impl<'a> BodyWriter<'a> {
                 while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
                     let n = st.next_layer + 1;
                     if p.host_metadata {
-                        mark(lines, 2, i - 1);
+                        mark(lines, points, 2, i - 1);
                         buf.extend_from_slice(format!(";LAYER:{}\n", n - 1).as_bytes());
                         match p.dialect {
                             Dialect::Klipper => buf.extend_from_slice(
@@ -764,7 +814,7 @@ impl<'a> BodyWriter<'a> {
                 if p.progress {
                     let percent = self.percent(st.t_done);
                     if percent != st.last_percent {
-                        mark(lines, 1, i - 1);
+                        mark(lines, points, 1, i - 1);
                         let left_min = ((self.nominal - st.t_done) * self.scale / 60.0)
                             .ceil()
                             .max(0.0);
@@ -779,18 +829,18 @@ impl<'a> BodyWriter<'a> {
             st.t_done += prev.pos.distance(q.pos) / q.speed;
             let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
             line.clear();
-            line.text(b"G1 X")
-                .fixed(q.pos.x - ox, 3)
-                .text(b" Y")
-                .fixed(q.pos.y - oy, 3)
-                .text(b" Z")
-                .fixed(q.pos.z, 3)
-                .text(b" E");
-            match p.extrusion {
-                ExtrusionMode::Relative => line.fixed(e, 5),
+            line.text(b"G1 X");
+            let x = line.fixed_read(q.pos.x - ox, 3);
+            line.text(b" Y");
+            let y = line.fixed_read(q.pos.y - oy, 3);
+            line.text(b" Z");
+            let z = line.fixed_read(q.pos.z, 3);
+            line.text(b" E");
+            let e = match p.extrusion {
+                ExtrusionMode::Relative => line.fixed_read(e, 5),
                 ExtrusionMode::Absolute => {
                     st.e_total += e;
-                    line.fixed(st.e_total, 5)
+                    line.fixed_read(st.e_total, 5)
                 }
             };
             if q.speed != st.last_speed {
@@ -799,8 +849,56 @@ impl<'a> BodyWriter<'a> {
             }
             line.text(b"\n");
             buf.extend_from_slice(line.as_bytes());
-            mark(lines, 1, i);
+            mark(lines, points, 1, i);
+            if want.moves {
+                // What the checker's reader makes of the line: X Y Z E as written.
+                match (x, y, z, e) {
+                    (Some(x), Some(y), Some(z), Some(e)) => moves.push(crate::check::Move {
+                        to: DVec3::new(x, y, z),
+                        de: e,
+                        line: *lines,
+                    }),
+                    _ => *told = false,
+                }
+            }
         }
+        *told &= want.moves;
+    }
+}
+
+/// What the body's writer gives besides the text.
+#[derive(Clone, Copy)]
+struct Wanted {
+    /// Each line's path point (the program's index).
+    index: bool,
+    /// Each line's move as the checker's reader reads it.
+    moves: bool,
+}
+
+/// A chunk of the body as formatted: its text, its lines, and what was wanted besides.
+#[derive(Default)]
+struct Piece {
+    text: Vec<u8>,
+    /// Lines in the text.
+    lines: usize,
+    /// The path point of each line (when the index is wanted).
+    points: Vec<u32>,
+    /// Each `G1` line's move as read before the modal state, its line counted from 1 in the
+    /// piece (when wanted): `crate::check::ToldPiece`'s.
+    moves: Vec<crate::check::Move>,
+    /// Whether `moves` are the piece's (wanted, and every number written as a plain decimal).
+    told: bool,
+}
+
+impl Piece {
+    /// Emptied for a chunk of `points` path points.
+    fn clear(&mut self, points: usize) {
+        self.text.clear();
+        self.text.reserve(points * 48);
+        self.lines = 0;
+        self.points.clear();
+        self.moves.clear();
+        self.told = true;
     }
 }
 
@@ -866,11 +964,15 @@ mod tests {
         let body = BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
         let (mut text, mut index) = (Vec::new(), Vec::new());
         body.write(&mut text, &mut Some(&mut index)).unwrap();
-        let mut whole = (Vec::new(), Vec::new());
-        body.format(1..n, BodyState::START, true, &mut whole);
-        let (whole, whole_index) = whole;
-        assert!(text == whole, "the texts differ");
-        assert_eq!(index, whole_index);
+        let mut whole = Piece::default();
+        let want = Wanted {
+            index: true,
+            moves: true,
+        };
+        body.format(1..n, BodyState::START, want, &mut whole);
+        assert!(text == whole.text, "the texts differ");
+        assert_eq!(index, whole.points);
+        assert_eq!(whole.lines, index.len());
         assert!(text.windows(4).any(|w| w == b"M73 "));
     }
 

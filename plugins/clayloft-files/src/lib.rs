@@ -224,12 +224,25 @@ pub fn export_gcode(design: &Design, job: &PrintJob, path: &Path) -> Result<Stri
         ExportError::Refused { .. } => format!("{}: not written: the design {e}", path.display()),
         other => other.to_string(),
     })?;
-    Ok(format!(
+    let mut said = format!(
         "wrote {} ({} points, {:.1} m of path)",
         path.display(),
         job.toolpath.points.len(),
         written.summary.path_length_mm / 1000.0
-    ))
+    );
+    if !written.unenforced.is_empty() {
+        // Constraints off: written as designed, and what it breaks is said.
+        let broken: Vec<_> = written
+            .unenforced
+            .iter()
+            .map(|v| format!("{} at {} moves", v.what, v.count))
+            .collect();
+        said.push_str(&format!(
+            "; constraints not enforced, the checker finds: {}",
+            broken.join(", ")
+        ));
+    }
+    Ok(said)
 }
 
 /// Writes the printed wall of a job as a binary STL, as `clayloft stl` does.

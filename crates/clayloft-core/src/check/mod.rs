@@ -28,6 +28,7 @@ use glam::DVec3;
 
 pub use limits::{Limits, LimitsError};
 use moves::MoveReader;
+pub(crate) use moves::ToldPiece;
 pub use moves::{GcodeError, Move, parse_moves};
 use report::Tally;
 pub use report::{
@@ -69,6 +70,12 @@ impl GcodeVerifier {
         GcodeVerifier {
             reader: MoveReader::with_capacity(moves),
         }
+    }
+
+    /// Takes pieces of the program whose moves the writer tells (see `ToldPiece`), reading only
+    /// the text of those it does not: what the G-code writer gives for the path's body.
+    pub(crate) fn feed_told(&mut self, pieces: &[ToldPiece<'_>]) {
+        self.reader.feed_told(pieces);
     }
 
     /// [`verify_gcode`]'s verdict on the text written.

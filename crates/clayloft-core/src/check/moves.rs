@@ -1,6 +1,8 @@
 //! The moves of a G-code program (G0/G1 with G90/G91, M82/M83, G92, G20/G21), as the
 //! checker reads them.
 
+use std::borrow::Cow;
+
 use glam::DVec3;
 
 use super::limits::truncated;
@@ -48,7 +50,7 @@ fn parse_moves_in(text: &str, part_bytes: usize) -> Result<(Vec<Move>, DVec3), G
 
 /// The lines of `text` read in parts of at least `part_bytes` each (cut after a newline), one
 /// thread each, in order.
-fn read_parts(text: &str, part_bytes: usize) -> Vec<Part> {
+fn read_parts(text: &str, part_bytes: usize) -> Vec<Part<'static>> {
     let mut texts = Vec::new();
     let mut rest = text;
     let want = part_bytes.max(1);
@@ -131,6 +133,34 @@ impl MoveReader {
         self.partial.extend_from_slice(rest);
     }
 
+    /// Takes pieces of text, each of whole lines, whose writer tells what they read as: where
+    /// a piece has its `moves` and no cut line waits, they are taken as its lines' reading and
+    /// the text is not read again; otherwise the text is read ([`MoveReader::feed`]). The
+    /// result is the same as feeding the texts when the moves are what [`read_part`] makes of
+    /// them (the G-code writer's are: tested in `gcode.rs`).
+    pub(crate) fn feed_told(&mut self, pieces: &[ToldPiece<'_>]) {
+        if self.error.is_some() {
+            return;
+        }
+        if !self.partial.is_empty() || pieces.iter().any(|p| p.moves.is_none()) {
+            pieces.iter().for_each(|p| self.feed(p.text));
+            return;
+        }
+        let parts = pieces
+            .iter()
+            .map(|p| Part {
+                moves: Cow::Borrowed(p.moves.unwrap_or_default()),
+                modal: Vec::new(),
+                error: None,
+                lines: p.lines,
+            })
+            .collect();
+        match resolve_parts(parts, &mut self.state, self.lines, &mut self.moves) {
+            Ok(lines) => self.lines += lines,
+            Err(e) => self.error = Some(e),
+        }
+    }
+
     /// The moves and where the first starts, once the whole text is in.
     pub fn finish(mut self) -> Result<(Vec<Move>, DVec3), GcodeError> {
         let rest = std::mem::take(&mut self.partial);
@@ -172,6 +202,16 @@ impl MoveReader {
     }
 }
 
+/// A piece of a program as its writer gives it: its text (whole lines, `lines` of them) and,
+/// where the writer can tell them, the moves its lines read as before the modal state (`to` the
+/// X Y Z given, `de` the E given, NaN where not given; `line` counted from 1 in the piece),
+/// with no line that changes a mode.
+pub(crate) struct ToldPiece<'a> {
+    pub text: &'a [u8],
+    pub moves: Option<&'a [Move]>,
+    pub lines: usize,
+}
+
 /// What changes the modal state, read from one line.
 #[derive(Debug, Clone, Copy)]
 enum Modal {
@@ -184,10 +224,10 @@ enum Modal {
 }
 
 /// One part of the file as read without the modal state.
-struct Part {
+struct Part<'a> {
     /// Its moves: `to` the X Y Z given and `de` the E given (NaN where not given), `line` within
-    /// the part.
-    moves: Vec<Move>,
+    /// the part: read here, or told by the writer of the text ([`MoveReader::feed_told`]).
+    moves: Cow<'a, [Move]>,
     /// The state changes, each before move `.0` of the part.
     modal: Vec<(usize, Modal)>,
     /// The first error, after all the part's moves.
@@ -248,7 +288,7 @@ impl State {
 /// the writer makes), those parts are resolved at the same time, one per core, each into its
 /// own stretch of `out`: the moves are copied out and their pages faulted in on both cores.
 fn resolve_parts(
-    mut parts: Vec<Part>,
+    mut parts: Vec<Part<'_>>,
     state: &mut State,
     lines_before: usize,
     out: &mut Vec<Move>,
@@ -306,7 +346,7 @@ fn resolve_parts(
 /// Resolves `parts` one after another into `out` (room reserved), the first starting after
 /// `lines` lines; gives the lines read up to the end of the last.
 fn resolve_in_turn(
-    parts: Vec<Part>,
+    parts: Vec<Part<'_>>,
     state: &mut State,
     mut lines: usize,
     out: &mut Vec<Move>,
@@ -322,7 +362,7 @@ fn resolve_in_turn(
     Ok(lines)
 }
 
-impl Part {
+impl Part<'_> {
     /// Applies the modal state to the part's moves in order, writing them to the start of
     /// `out` (room for all of them) with their lines counted from the file's start; `state`
     /// is left as the part leaves it. Gives how many moves were written (all but after an
@@ -336,7 +376,7 @@ impl Part {
         let count = self.moves.len();
         assert!(out.len() >= count, "room for every move of the part");
         let mut modal = self.modal.iter().peekable();
-        for ((k, m), slot) in self.moves.into_iter().enumerate().zip(out.iter_mut()) {
+        for ((k, &m), slot) in self.moves.iter().enumerate().zip(out.iter_mut()) {
             while let Some((_, change)) = modal.next_if(|(at, _)| *at == k) {
                 state.apply(*change);
             }
@@ -415,9 +455,9 @@ impl Part {
 }
 
 /// Reads the lines of `text` without the modal state (see [`Part`]); stops at the first error.
-fn read_part(text: &str) -> Part {
+fn read_part(text: &str) -> Part<'static> {
     let mut part = Part {
-        moves: Vec::with_capacity(text.len() / 40),
+        moves: Cow::Owned(Vec::with_capacity(text.len() / 40)),
         modal: Vec::new(),
         error: None,
         lines: 0,
@@ -499,12 +539,13 @@ fn plain_move(raw: &[u8]) -> Option<[f64; 4]> {
     Some([given[0], given[1], given[2], given[3]])
 }
 
-fn read_lines(text: &str, part: &mut Part) -> Result<(), GcodeError> {
+fn read_lines(text: &str, part: &mut Part<'_>) -> Result<(), GcodeError> {
+    let moves = part.moves.to_mut();
     for (idx, raw) in text.lines().enumerate() {
         let line = idx + 1;
         part.lines = line;
         if let Some([x, y, z, e]) = plain_move(raw.as_bytes()) {
-            part.moves.push(Move {
+            moves.push(Move {
                 to: DVec3::new(x, y, z),
                 de: e,
                 line,
@@ -540,26 +581,24 @@ fn read_lines(text: &str, part: &mut Part) -> Result<(), GcodeError> {
         let given = |v: Option<f64>| v.unwrap_or(f64::NAN);
         if is("G1") || is("G0") || is("G01") || is("G00") {
             let (x, y, z, ev) = (arg('X')?, arg('Y')?, arg('Z')?, arg('E')?);
-            part.moves.push(Move {
+            moves.push(Move {
                 to: DVec3::new(given(x), given(y), given(z)),
                 de: given(ev),
                 line,
             });
         } else if is("G90") {
-            part.modal
-                .push((part.moves.len(), Modal::AbsoluteXyz(true)));
+            part.modal.push((moves.len(), Modal::AbsoluteXyz(true)));
         } else if is("G91") {
-            part.modal
-                .push((part.moves.len(), Modal::AbsoluteXyz(false)));
+            part.modal.push((moves.len(), Modal::AbsoluteXyz(false)));
         } else if is("M82") {
-            part.modal.push((part.moves.len(), Modal::AbsoluteE(true)));
+            part.modal.push((moves.len(), Modal::AbsoluteE(true)));
         } else if is("M83") {
-            part.modal.push((part.moves.len(), Modal::AbsoluteE(false)));
+            part.modal.push((moves.len(), Modal::AbsoluteE(false)));
         } else if is("G92") {
             let e = arg('E')?;
             let (x, y, z) = (arg('X')?, arg('Y')?, arg('Z')?);
             part.modal.push((
-                part.moves.len(),
+                moves.len(),
                 Modal::SetPosition([given(x), given(y), given(z), given(e)]),
             ));
         } else if is("G20") {
@@ -568,7 +607,7 @@ fn read_lines(text: &str, part: &mut Part) -> Result<(), GcodeError> {
                 message: "inch units (G20) are not supported".into(),
             });
         } else if is("G28") {
-            part.modal.push((part.moves.len(), Modal::Home));
+            part.modal.push((moves.len(), Modal::Home));
         } else if cmd.starts_with(['G', 'M', 'T', 'N', 'F', 'S', 'g', 'm', 't', 'n', 'f', 's'])
             && cmd[1..].parse::<f64>().is_ok()
         {
@@ -806,6 +845,104 @@ mod tests {
         reader.feed(b"G1 X1\nG1 X2 E1");
         let (moves, _) = reader.finish().unwrap();
         assert_eq!((moves.len(), moves[1].to.x, moves[1].de), (2, 2.0, 1.0));
+    }
+
+    /// A program written with its body's moves told (as `clayloft gcode` hands them to its
+    /// self-check) reads as its text: the same moves, ends, E and lines, to the bit, on a
+    /// corner-origin and centre-origin printer, Klipper's dialect, absolute E, with the hosts'
+    /// layer and progress lines and without, over several rounds of the writer's pieces.
+    #[test]
+    fn a_body_told_by_its_writer_reads_as_its_text() {
+        struct Recording {
+            text: Vec<u8>,
+            reader: MoveReader,
+            told: usize,
+        }
+        impl crate::gcode::ProgramOut for Recording {
+            fn text(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+                self.text.extend_from_slice(bytes);
+                self.reader.feed(bytes);
+                Ok(())
+            }
+            fn wants_moves(&self) -> bool {
+                true
+            }
+            fn body(&mut self, pieces: &[ToldPiece<'_>]) -> std::io::Result<()> {
+                for p in pieces {
+                    self.text.extend_from_slice(p.text);
+                    self.told += usize::from(p.moves.is_some());
+                }
+                self.reader.feed_told(pieces);
+                Ok(())
+            }
+        }
+        let bits = |m: &Move| (m.to.to_array().map(f64::to_bits), m.de.to_bits(), m.line);
+        for printer in [
+            "",
+            "profile = \"klipper-paste-delta\"\n",
+            "profile = \"wasp-2040-clay\"\nextrusion = \"absolute\"\n",
+            "extrusion = \"absolute\"\nhost_metadata = false\nprogress = false\n",
+            "host_metadata = true\nprogress = true\n",
+        ] {
+            let design = crate::load::parse_design(&format!(
+                "version = 1\n[printer]\n{printer}[shape]\nheight = 120.0\nsamples = 480\nbase_layers = 1\n\
+                 lower = {{ type = \"circle\", radius = 30.0 }}\nupper = {{ type = \"circle\", radius = 34.0 }}\n\
+                 [texture.x]\nwave = \"sine\"\nperiod = 7\namplitude = 1.0\n"
+            ))
+            .unwrap();
+            let job = crate::run(&design).unwrap();
+            assert!(
+                job.toolpath.points.len() > 3 * 16 * 1024,
+                "several rounds of pieces"
+            );
+            let mut out = Recording {
+                text: Vec::new(),
+                reader: MoveReader::with_capacity(0),
+                told: 0,
+            };
+            crate::gcode::write_program_to(&design, &job, &mut out).unwrap();
+            assert!(out.told >= 3, "{printer}: the body's pieces are told");
+            let (told, told_start) = out.reader.finish().unwrap();
+            let (read, read_start) = parse_moves(std::str::from_utf8(&out.text).unwrap()).unwrap();
+            assert_eq!(told.len(), read.len(), "{printer}");
+            assert_eq!(told_start, read_start);
+            for (t, r) in told.iter().zip(&read) {
+                assert_eq!(bits(t), bits(r), "{printer}: line {}", r.line);
+            }
+        }
+    }
+
+    /// Pieces not told, or told while a cut line waits, are read as text: the same moves as
+    /// feeding the text.
+    #[test]
+    fn pieces_not_told_are_read() {
+        let text = "G90\nM83\nG1 X1 Y2 Z0.5 E0.1\nG1 X2 Y2 Z0.5 E0.1\nG1 X3 Y2 Z0.5 E0.1\n";
+        let (want, _) = parse_moves(text).unwrap();
+        let (head, body) = text.split_at(8);
+        // Told moves that are wrong on purpose: taken only where they may be.
+        let wrong = [Move {
+            to: DVec3::splat(9.0),
+            de: 9.0,
+            line: 1,
+        }];
+        let mut not_told = MoveReader::with_capacity(0);
+        not_told.feed(head.as_bytes());
+        not_told.feed_told(&[ToldPiece {
+            text: body.as_bytes(),
+            moves: None,
+            lines: 3,
+        }]);
+        assert_eq!(not_told.finish().unwrap().0, want);
+        let mut cut = MoveReader::with_capacity(0);
+        cut.feed(&head.as_bytes()[..5]);
+        cut.feed(&head.as_bytes()[5..]);
+        cut.feed(b"G1 X1 Y2");
+        cut.feed_told(&[ToldPiece {
+            text: &body.as_bytes()[8..],
+            moves: Some(&wrong),
+            lines: 3,
+        }]);
+        assert_eq!(cut.finish().unwrap().0, want);
     }
 
     #[test]

@@ -17,6 +17,22 @@ pub struct Violation {
     pub detail: String,
 }
 
+/// The checker's line for a violation: "VIOLATION overhang: 528 moves, worst 77.528°, first at
+/// line 1552 (wall leans past 45°)".
+impl fmt::Display for Violation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "VIOLATION {}: {} moves{}, first at line {} ({})",
+            self.what,
+            self.count,
+            self.worst_said(3),
+            self.first_line,
+            self.detail
+        )
+    }
+}
+
 impl Violation {
     /// ", worst 0.19 mm short" with `decimals`, or nothing where `worst` measures nothing.
     pub fn worst_said(&self, decimals: usize) -> String {
@@ -111,15 +127,7 @@ impl fmt::Display for CheckReport {
             write!(f, "all limits hold")
         } else {
             for v in &self.violations {
-                writeln!(
-                    f,
-                    "VIOLATION {}: {} moves{}, first at line {} ({})",
-                    v.what,
-                    v.count,
-                    v.worst_said(3),
-                    v.first_line,
-                    v.detail
-                )?;
+                writeln!(f, "{v}")?;
             }
             write!(f, "{} limit(s) broken", self.violations.len())
         }
