@@ -471,6 +471,31 @@ mod tests {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/designs/pebble-spout.toml")
     }
 
+    /// "Export G-code" of a design whose constraints are not enforced writes it as designed and
+    /// says what the checker finds in it; enforced, the same vessel prints and says nothing
+    /// more.
+    #[test]
+    fn an_unenforced_export_says_what_the_checker_finds() {
+        let bowl =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/designs/flared-bowl.toml");
+        let dir = tempfile::tempdir().unwrap();
+        for enforce in [false, true] {
+            let mut design = open_design(&bowl).unwrap();
+            design.constraints.enforce = enforce;
+            let job = clayloft_core::run(&design).unwrap();
+            let out = dir.path().join(format!("bowl-{enforce}.gcode"));
+            let said = export_gcode(&design, &job, &out).unwrap();
+            assert!(out.exists(), "{said}");
+            let found = said.split_once("; constraints not enforced, the checker finds: ");
+            if enforce {
+                assert!(found.is_none(), "{said}");
+            } else {
+                let (_, found) = found.unwrap_or_else(|| panic!("{said}"));
+                assert!(found.contains("overhang at "), "{said}");
+            }
+        }
+    }
+
     #[test]
     fn every_shipped_design_saves_and_loads_back_identical() {
         let dir = tempfile::tempdir().unwrap();
