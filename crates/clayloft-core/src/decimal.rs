@@ -81,7 +81,16 @@ impl Line {
     /// `decimals` is at most [`MAX_DECIMALS`].
     #[inline]
     pub fn fixed(&mut self, v: f64, decimals: u32) -> &mut Self {
-        self.fixed_read(v, decimals);
+        match decimals {
+            0 => self.fixed_const::<0, false>(v),
+            1 => self.fixed_const::<1, false>(v),
+            2 => self.fixed_const::<2, false>(v),
+            3 => self.fixed_const::<3, false>(v),
+            4 => self.fixed_const::<4, false>(v),
+            5 => self.fixed_const::<5, false>(v),
+            6 => self.fixed_const::<6, false>(v),
+            _ => panic!("at most {MAX_DECIMALS} decimals, not {decimals}"),
+        };
         self
     }
 
@@ -92,20 +101,21 @@ impl Line {
     #[inline]
     pub fn fixed_read(&mut self, v: f64, decimals: u32) -> Option<f64> {
         match decimals {
-            0 => self.fixed_const::<0>(v),
-            1 => self.fixed_const::<1>(v),
-            2 => self.fixed_const::<2>(v),
-            3 => self.fixed_const::<3>(v),
-            4 => self.fixed_const::<4>(v),
-            5 => self.fixed_const::<5>(v),
-            6 => self.fixed_const::<6>(v),
+            0 => self.fixed_const::<0, true>(v),
+            1 => self.fixed_const::<1, true>(v),
+            2 => self.fixed_const::<2, true>(v),
+            3 => self.fixed_const::<3, true>(v),
+            4 => self.fixed_const::<4, true>(v),
+            5 => self.fixed_const::<5, true>(v),
+            6 => self.fixed_const::<6, true>(v),
             _ => panic!("at most {MAX_DECIMALS} decimals, not {decimals}"),
         }
     }
 
-    /// [`Line::fixed_read`] with the decimals known to the compiler.
+    /// [`Line::fixed_read`] with the decimals known to the compiler; the number read only with
+    /// `READ` (else None: the writer of text alone pays no division).
     #[inline]
-    fn fixed_const<const D: u32>(&mut self, v: f64) -> Option<f64> {
+    fn fixed_const<const D: u32, const READ: bool>(&mut self, v: f64) -> Option<f64> {
         let pow = 10u64.pow(D);
         let x = v.abs() * pow as f64;
         // Out of range for integer formatting (never for a real printer), or not a number.
@@ -148,7 +158,7 @@ impl Line {
         }
         // The reader's fast path takes up to 19 digits below 2⁵³ (as the standard parser
         // would read more, it is left to it: None).
-        if n >= 1 << 53 {
+        if !READ || n >= 1 << 53 {
             return None;
         }
         let read = n as f64 / EXACT_POWERS[D as usize];

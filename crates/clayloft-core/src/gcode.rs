@@ -829,18 +829,27 @@ impl<'a> BodyWriter<'a> {
             st.t_done += prev.pos.distance(q.pos) / q.speed;
             let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
             line.clear();
+            // Each number written, and read back where the moves are wanted.
+            let number = |line: &mut Line, v: f64, decimals: u32| {
+                if want.moves {
+                    line.fixed_read(v, decimals)
+                } else {
+                    line.fixed(v, decimals);
+                    None
+                }
+            };
             line.text(b"G1 X");
-            let x = line.fixed_read(q.pos.x - ox, 3);
+            let x = number(&mut line, q.pos.x - ox, 3);
             line.text(b" Y");
-            let y = line.fixed_read(q.pos.y - oy, 3);
+            let y = number(&mut line, q.pos.y - oy, 3);
             line.text(b" Z");
-            let z = line.fixed_read(q.pos.z, 3);
+            let z = number(&mut line, q.pos.z, 3);
             line.text(b" E");
             let e = match p.extrusion {
-                ExtrusionMode::Relative => line.fixed_read(e, 5),
+                ExtrusionMode::Relative => number(&mut line, e, 5),
                 ExtrusionMode::Absolute => {
                     st.e_total += e;
-                    line.fixed_read(st.e_total, 5)
+                    number(&mut line, st.e_total, 5)
                 }
             };
             if q.speed != st.last_speed {
