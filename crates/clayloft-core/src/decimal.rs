@@ -81,16 +81,7 @@ impl Line {
     /// `decimals` is at most [`MAX_DECIMALS`].
     #[inline]
     pub fn fixed(&mut self, v: f64, decimals: u32) -> &mut Self {
-        match decimals {
-            0 => self.fixed_const::<0, false>(v),
-            1 => self.fixed_const::<1, false>(v),
-            2 => self.fixed_const::<2, false>(v),
-            3 => self.fixed_const::<3, false>(v),
-            4 => self.fixed_const::<4, false>(v),
-            5 => self.fixed_const::<5, false>(v),
-            6 => self.fixed_const::<6, false>(v),
-            _ => panic!("at most {MAX_DECIMALS} decimals, not {decimals}"),
-        };
+        self.fixed_with::<false>(v, decimals);
         self
     }
 
@@ -100,14 +91,21 @@ impl Line {
     /// finite, or past the integers formatted here).
     #[inline]
     pub fn fixed_read(&mut self, v: f64, decimals: u32) -> Option<f64> {
+        self.fixed_with::<true>(v, decimals)
+    }
+
+    /// [`Line::fixed`] (`READ` false) or [`Line::fixed_read`] (true): the decimals handed to the
+    /// compiler as a constant.
+    #[inline]
+    fn fixed_with<const READ: bool>(&mut self, v: f64, decimals: u32) -> Option<f64> {
         match decimals {
-            0 => self.fixed_const::<0, true>(v),
-            1 => self.fixed_const::<1, true>(v),
-            2 => self.fixed_const::<2, true>(v),
-            3 => self.fixed_const::<3, true>(v),
-            4 => self.fixed_const::<4, true>(v),
-            5 => self.fixed_const::<5, true>(v),
-            6 => self.fixed_const::<6, true>(v),
+            0 => self.fixed_const::<0, READ>(v),
+            1 => self.fixed_const::<1, READ>(v),
+            2 => self.fixed_const::<2, READ>(v),
+            3 => self.fixed_const::<3, READ>(v),
+            4 => self.fixed_const::<4, READ>(v),
+            5 => self.fixed_const::<5, READ>(v),
+            6 => self.fixed_const::<6, READ>(v),
             _ => panic!("at most {MAX_DECIMALS} decimals, not {decimals}"),
         }
     }

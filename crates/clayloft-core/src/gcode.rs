@@ -783,6 +783,15 @@ impl<'a> BodyWriter<'a> {
             told,
         } = piece;
         let mut line = Line::new();
+        // Each number written, and read back where the moves are wanted.
+        let number = |line: &mut Line, v: f64, decimals: u32| {
+            if want.moves {
+                line.fixed_read(v, decimals)
+            } else {
+                line.fixed(v, decimals);
+                None
+            }
+        };
         // Counts `count` lines at path point `point`.
         let mark = |lines: &mut usize, points: &mut Vec<u32>, count: usize, point: usize| {
             *lines += count;
@@ -829,15 +838,6 @@ impl<'a> BodyWriter<'a> {
             st.t_done += prev.pos.distance(q.pos) / q.speed;
             let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
             line.clear();
-            // Each number written, and read back where the moves are wanted.
-            let number = |line: &mut Line, v: f64, decimals: u32| {
-                if want.moves {
-                    line.fixed_read(v, decimals)
-                } else {
-                    line.fixed(v, decimals);
-                    None
-                }
-            };
             line.text(b"G1 X");
             let x = number(&mut line, q.pos.x - ox, 3);
             line.text(b" Y");
