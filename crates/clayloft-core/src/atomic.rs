@@ -28,7 +28,7 @@ pub fn write_atomically<T>(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<T>,
 ) -> Result<T, WriteError> {
-    let (pending, filled) = prepare(path, fill)?;
+    let (pending, filled) = prepare(path, |w| fill(w))?;
     drop(pending.commit()?);
     Ok(filled)
 }
@@ -102,7 +102,7 @@ fn destination(path: &Path) -> (PathBuf, bool) {
 /// in place.
 pub fn prepare<T>(
     path: &Path,
-    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<T>,
+    fill: impl FnOnce(&mut (dyn Write + Send)) -> std::io::Result<T>,
 ) -> Result<(Pending, T), WriteError> {
     let err = |reason: String| WriteError {
         file: path.display().to_string(),

@@ -149,11 +149,10 @@ fn check_moves(
     let first_ext = moves.iter().position(|m| m.de > 0.0);
     let last_ext = moves.iter().rposition(|m| m.de > 0.0);
     let extruding = first_ext.zip(last_ext);
-    let path = extruding_path(moves, start, shift, extruding, || {
-        tally_moves(moves, start, limits, extruding, &mut report)
-    });
-    if let Some((extruding, vertices, lines)) = path {
-        report.extruding_moves = moves[extruding].iter().filter(|m| m.de > 0.0).count();
+    let tally = |range| MoveTally::of(moves, range, start, limits, extruding);
+    let (path, tallied) = extruding_path(moves, start, shift, extruding, tally);
+    tallied.into_report(limits, &mut report);
+    if let Some((vertices, lines)) = path {
         if show {
             let shown = layers::layers_hold(&vertices, &lines, limits, &mut report);
             return Ok((report, shown));
@@ -163,21 +162,28 @@ fn check_moves(
     Ok((report, show))
 }
 
+/// The points of an extruding path in the bed frame, and each one's G-code line.
+type PathPoints = (Vec<DVec3>, Vec<usize>);
+
 /// The extruding path `moves[a..=b]` (`extruding`: a and b) for the layer search: the point it
-/// starts from and each move's end, in the bed frame (`shift` added), with each point's line.
-/// Copied out in two halves, one on a second core and one on this one after `beside` (which
-/// runs meanwhile): the copy is mostly the new buffers' page faults (3.2 ms on one core for
-/// the benchmark vase's 7 MB).
+/// starts from and each move's end, in the bed frame (`shift` added), with each point's line;
+/// and the moves' tally (`tally` of a range of moves: see [`MoveTally`]). In two halves, one on
+/// a second core and one on this one, each copying its half of the path and tallying its half
+/// of the moves: the copy is mostly the new buffers' page faults (3.2 ms on one core for the
+/// benchmark vase's 7 MB), the tally a pass over every move.
 fn extruding_path(
     moves: &[Move],
     start: DVec3,
     shift: DVec3,
     extruding: Option<(usize, usize)>,
-    beside: impl FnOnce(),
-) -> Option<(std::ops::RangeInclusive<usize>, Vec<DVec3>, Vec<usize>)> {
+    tally: impl Fn(std::ops::Range<usize>) -> MoveTally + Sync,
+) -> (Option<PathPoints>, MoveTally) {
+    let halves = |count: usize| [0..count / 2, count / 2..count];
+    let two_cores = moves.len() >= crate::parallel::PARALLEL_POINTS;
     let Some((a, b)) = extruding else {
-        beside();
-        return None;
+        let [first, second] = halves(moves.len());
+        let (t0, t1) = crate::parallel::both(two_cores, || tally(first), || tally(second));
+        return (None, t0.then(t1));
     };
     // Point k of the path is where move a + k − 1 ends (point 0: where move a starts); its
     // line is that move's (point 0: move a's).
@@ -199,12 +205,16 @@ fn extruding_path(
     let half = count / 2;
     let (p0, p1) = vertices.spare_capacity_mut()[..count].split_at_mut(half);
     let (l0, l1) = lines.spare_capacity_mut()[..count].split_at_mut(half);
-    crate::parallel::both(
-        count >= crate::parallel::PARALLEL_POINTS,
-        || fill(0, p0, l0),
+    let [first, second] = halves(moves.len());
+    let (t0, t1) = crate::parallel::both(
+        two_cores,
         || {
-            beside();
+            fill(0, p0, l0);
+            tally(first)
+        },
+        || {
             fill(half, p1, l1);
+            tally(second)
         },
     );
     // SAFETY: the two halves wrote every one of the first `count` slots of both buffers.
@@ -212,86 +222,132 @@ fn extruding_path(
         vertices.set_len(count);
         lines.set_len(count);
     }
-    Some((a..=b, vertices, lines))
+    (Some((vertices, lines)), t0.then(t1))
 }
 
-/// The bounds of the extruding moves, and the violations of single moves (outside the machine,
-/// a move without extrusion within the path `extruding`, a retraction), into `report`.
-fn tally_moves(
-    moves: &[Move],
-    start: DVec3,
-    limits: &Limits,
-    extruding: Option<(usize, usize)>,
-    report: &mut CheckReport,
-) {
-    let [ox, oy] = limits.origin_offset();
-    let shift = DVec3::new(ox, oy, 0.0);
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    let (mut outside, mut travel, mut retract) =
-        (Tally::default(), Tally::default(), Tally::default());
-    let mut prev = start;
-    for (k, m) in moves.iter().enumerate() {
-        let to = m.to + shift;
-        if m.de > 0.0 {
-            lo = lo.min(to);
-            hi = hi.max(to);
+/// What single moves show, tallied over a range of them: the bounds of the extruding moves,
+/// those outside the machine, moves without extrusion within the extruding path, retractions,
+/// and how many moves extrude within it. Ranges tallied apart join in path order
+/// ([`MoveTally::then`]) to the tally of the whole.
+#[derive(Debug, PartialEq)]
+struct MoveTally {
+    lo: DVec3,
+    hi: DVec3,
+    outside: Tally,
+    travel: Tally,
+    retract: Tally,
+    extruding: usize,
+}
+
+impl MoveTally {
+    /// The tally of `moves[range]` (the move before the range ends where its first starts;
+    /// the first move starts at `start`), `extruding` the first and last extruding move.
+    fn of(
+        moves: &[Move],
+        range: std::ops::Range<usize>,
+        start: DVec3,
+        limits: &Limits,
+        extruding: Option<(usize, usize)>,
+    ) -> MoveTally {
+        let [ox, oy] = limits.origin_offset();
+        let shift = DVec3::new(ox, oy, 0.0);
+        let mut t = MoveTally {
+            lo: DVec3::splat(f64::INFINITY),
+            hi: DVec3::splat(f64::NEG_INFINITY),
+            outside: Tally::default(),
+            travel: Tally::default(),
+            retract: Tally::default(),
+            extruding: 0,
+        };
+        let mut prev = match range.start {
+            0 => start,
+            k => moves[k - 1].to + shift,
+        };
+        for (k, m) in range.clone().zip(&moves[range]) {
+            let to = m.to + shift;
+            if m.de > 0.0 {
+                t.lo = t.lo.min(to);
+                t.hi = t.hi.max(to);
+            }
+            let eps = 1e-6;
+            if !limits.on_bed(to.x, to.y, eps) || to.z < -eps || to.z > limits.max_z + eps {
+                t.outside.add(0.0, m.line);
+            }
+            if m.de < 0.0 {
+                t.retract.add(-m.de, m.line);
+            }
+            if let Some((a, b)) = extruding
+                && k >= a
+                && k <= b
+            {
+                if m.de > 0.0 {
+                    t.extruding += 1;
+                } else if k > a && to != prev {
+                    t.travel.add(to.distance(prev), m.line);
+                }
+            }
+            prev = to;
         }
-        let eps = 1e-6;
-        if !limits.on_bed(to.x, to.y, eps) || to.z < -eps || to.z > limits.max_z + eps {
-            outside.add(0.0, m.line);
-        }
-        if m.de < 0.0 {
-            retract.add(-m.de, m.line);
-        }
-        if let Some((a, b)) = extruding
-            && k > a
-            && k <= b
-            && m.de <= 0.0
-            && to != prev
-        {
-            travel.add(to.distance(prev), m.line);
-        }
-        prev = to;
+        t
     }
-    if lo.is_finite() {
-        report.bounds_min = lo;
-        report.bounds_max = hi;
+
+    /// This tally followed by `later`'s (of the moves after this one's).
+    fn then(self, later: MoveTally) -> MoveTally {
+        MoveTally {
+            lo: self.lo.min(later.lo),
+            hi: self.hi.max(later.hi),
+            outside: self.outside.then(later.outside),
+            travel: self.travel.then(later.travel),
+            retract: self.retract.then(later.retract),
+            extruding: self.extruding + later.extruding,
+        }
     }
-    report.violations.extend(
-        [
-            outside.into_violation(
-                OUTSIDE,
-                "",
-                match limits.bed_shape {
-                    crate::design::BedShape::Rectangle => format!(
-                        "bed {} … {} × {} … {} mm, height 0 … {} mm",
-                        -ox,
-                        limits.bed_x - ox,
-                        -oy,
-                        limits.bed_y - oy,
-                        limits.max_z
-                    ),
-                    crate::design::BedShape::Circle => format!(
-                        "round bed {} mm across, height 0 … {} mm",
-                        limits.bed_x, limits.max_z
-                    ),
-                },
-            ),
-            travel.into_violation(
-                NOT_CONTINUOUS,
-                " mm (the longest)",
-                "moves without extrusion between the first and last extruding move".into(),
-            ),
-            retract.into_violation(
-                RETRACTION,
-                " mm of E",
-                "clay printing allows no retraction".into(),
-            ),
-        ]
-        .into_iter()
-        .flatten(),
-    );
+
+    /// The bounds, the extruding moves' count and the violations of single moves (outside
+    /// the machine, a move without extrusion within the extruding path, a retraction), into
+    /// `report`.
+    fn into_report(self, limits: &Limits, report: &mut CheckReport) {
+        let [ox, oy] = limits.origin_offset();
+        if self.lo.is_finite() {
+            report.bounds_min = self.lo;
+            report.bounds_max = self.hi;
+        }
+        report.extruding_moves = self.extruding;
+        report.violations.extend(
+            [
+                self.outside.into_violation(
+                    OUTSIDE,
+                    "",
+                    match limits.bed_shape {
+                        crate::design::BedShape::Rectangle => format!(
+                            "bed {} … {} × {} … {} mm, height 0 … {} mm",
+                            -ox,
+                            limits.bed_x - ox,
+                            -oy,
+                            limits.bed_y - oy,
+                            limits.max_z
+                        ),
+                        crate::design::BedShape::Circle => format!(
+                            "round bed {} mm across, height 0 … {} mm",
+                            limits.bed_x, limits.max_z
+                        ),
+                    },
+                ),
+                self.travel.into_violation(
+                    NOT_CONTINUOUS,
+                    " mm (the longest)",
+                    "moves without extrusion between the first and last extruding move".into(),
+                ),
+                self.retract.into_violation(
+                    RETRACTION,
+                    " mm of E",
+                    "clay printing allows no retraction".into(),
+                ),
+            ]
+            .into_iter()
+            .flatten(),
+        );
+    }
 }
 
 /// Measures an extruding path (layer heights, overhang, support, holder collision) given as
@@ -328,6 +384,44 @@ mod tests {
 
     fn limits() -> Limits {
         Limits::from(&Printer::default())
+    }
+
+    proptest::proptest! {
+        /// Moves tallied in two parts and joined give the tally of all of them, wherever the
+        /// parts meet: moves on and off the bed, extruding, travelling and retracting, on a
+        /// printer with its origin in the middle (so that the parts' first moves start from a
+        /// shifted end).
+        #[test]
+        fn moves_tallied_in_parts_are_tallied_whole(
+            steps in proptest::collection::vec(
+                (-20.0..320.0f64, -20.0..320.0f64, -1.0..5.0f64, -2i32..4),
+                1..60,
+            ),
+            cut in 0.0..=1.0f64,
+        ) {
+            let mut limits = limits();
+            limits.origin = crate::design::Origin::Centre;
+            let moves: Vec<Move> = steps
+                .iter()
+                .enumerate()
+                .map(|(k, &(x, y, z, e))| Move {
+                    to: DVec3::new(x - 150.0, y - 150.0, z),
+                    de: f64::from(e.clamp(-1, 2)) * 0.5,
+                    line: k + 10,
+                })
+                .collect();
+            let start = DVec3::new(150.0, 150.0, 0.2);
+            let extruding = moves
+                .iter()
+                .position(|m| m.de > 0.0)
+                .zip(moves.iter().rposition(|m| m.de > 0.0));
+            let tally = |r| MoveTally::of(&moves, r, start, &limits, extruding);
+            let m = (cut * moves.len() as f64) as usize;
+            proptest::prop_assert_eq!(
+                tally(0..m).then(tally(m..moves.len())),
+                tally(0..moves.len())
+            );
+        }
     }
 
     fn helix(radius_per_layer: f64, layers: usize, h: f64) -> String {

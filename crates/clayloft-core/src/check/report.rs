@@ -135,7 +135,7 @@ impl fmt::Display for CheckReport {
 }
 
 /// Collects violations of one kind.
-#[derive(Default)]
+#[derive(Debug, Default, PartialEq)]
 pub(super) struct Tally {
     count: usize,
     worst: f64,
@@ -158,6 +158,20 @@ impl Tally {
             first_line: self.first_line,
             detail,
         })
+    }
+
+    /// This tally followed by `later`'s (of what comes after in the path): as if every value
+    /// had been added to one, in order.
+    pub(super) fn then(self, later: Tally) -> Tally {
+        match (self.count, later.count) {
+            (0, _) => later,
+            (_, 0) => self,
+            _ => Tally {
+                count: self.count + later.count,
+                worst: self.worst.max(later.worst),
+                first_line: self.first_line,
+            },
+        }
     }
 
     pub(super) fn add(&mut self, value: f64, line: usize) {
