@@ -6,9 +6,11 @@ pause (a single command after the machine idled, as a potter runs it).
     scripts/whole-process.py OLD_BINARY NEW_BINARY            # 30 rounds back to back
     scripts/whole-process.py --pause 1.5 --rounds 12 OLD NEW  # each run after 1.5 s idle
 
-Prints the minimum, first quartile, median and maximum wall time of each, in ms.
+Prints the minimum, first quartile, median and maximum wall time of each, in ms, and the median
+processor time (user and system, both cores together), which a busy shared machine moves less.
 """
 import argparse
+import os
 import statistics
 import subprocess
 import tempfile
@@ -27,14 +29,20 @@ args = parser.parse_args()
 with tempfile.TemporaryDirectory() as work:
     out = str(Path(work) / "vase.gcode")
     times = {b: [] for b in args.binaries}
+    cpu = {b: [] for b in args.binaries}
     for _ in range(args.rounds):
         for b in args.binaries:
             time.sleep(args.pause)
             start = time.perf_counter()
-            subprocess.run([b, "gcode", args.design, "-o", out], check=True,
-                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            child = subprocess.Popen([b, "gcode", args.design, "-o", out],
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            _, status, usage = os.wait4(child.pid, 0)
             times[b].append((time.perf_counter() - start) * 1000)
+            if os.waitstatus_to_exitcode(status) != 0:
+                raise SystemExit(f"{b} gcode {args.design} failed")
+            cpu[b].append((usage.ru_utime + usage.ru_stime) * 1000)
     for b, t in times.items():
         t.sort()
         print(f"{b}: min {t[0]:.1f}  p25 {t[len(t) // 4]:.1f}  "
-              f"median {statistics.median(t):.1f}  max {t[-1]:.1f} ms")
+              f"median {statistics.median(t):.1f}  max {t[-1]:.1f} ms; "
+              f"processor median {statistics.median(cpu[b]):.1f} ms")

@@ -164,7 +164,7 @@ fn main() -> ExitCode {
         cli.command,
         Some(Command::Gcode { .. } | Command::Stl { .. } | Command::Check { .. })
     ) {
-        clayloft_core::heap::keep_freed_memory();
+        clayloft_core::heap::tune_for_batch_command();
     }
     let result = match cli.command {
         Some(Command::Gcode {
