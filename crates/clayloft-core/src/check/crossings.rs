@@ -208,6 +208,9 @@ impl Work {
         }
         budget -= all.len() - block.len();
         let centre = centre_of(&v[chords[first].0..=chords[block.end - 1].1]);
+        if self.goes_round_less_than_once(path, first, block.clone(), centre) {
+            return judged;
+        }
         let chord = |c: usize| (v[chords[first + c].0], v[chords[first + c].1]);
         let count = all.len();
         let head = block.start - first;
@@ -336,6 +339,52 @@ impl Work {
             }
         }
         judged
+    }
+
+    /// Whether no chord of `block` can close a loop, shown for the whole block at once: every
+    /// chord from `first` (the first any of its windows reaches) to its end goes round `centre`
+    /// the same way, and from the first chord within `limits.reach` of path of each chord of
+    /// the block to its end, less than once round. Such a stretch cannot cross itself (see the
+    /// module documentation), and each chord's window lies within it. A wall that goes on round
+    /// its axis, textured or not, is shown a block at a time, with one division a chord; a
+    /// base's small rings and a wall that turns back are judged chord by chord.
+    ///
+    /// Unwrapped angles: a chord that goes round one way turns through less than a half-turn,
+    /// its ends' [`pseudo_angle`]s 0 … 2 apart that way (`wrapped`); added up chord by chord
+    /// they give the angle turned since `first` in units of 4 a turn, to within a few ulps a
+    /// chord, so the test allows a millionth of a unit.
+    fn goes_round_less_than_once<U>(
+        &mut self,
+        path: &Path<U>,
+        first: usize,
+        block: std::ops::Range<usize>,
+        centre: DVec2,
+    ) -> bool {
+        let (v, chords) = (path.v, path.chords);
+        let around = |i: usize| v[i].truncate() - centre;
+        let way = {
+            let (a, b) = chords[first];
+            around(a).perp_dot(around(b)).signum()
+        };
+        // The angle turned by each chord's end since the start of chord `first`.
+        self.turn.clear();
+        let (mut turned, mut last) = (0.0, pseudo_angle_or_zero(around(chords[first].0)));
+        for &(a, b) in &chords[first..block.end] {
+            // Strictly one way round (not through the centre, not along a ray; no NaN).
+            if !(around(a).perp_dot(around(b)) * way > 0.0) {
+                return false;
+            }
+            let angle = pseudo_angle(around(b));
+            turned += wrapped(angle - last);
+            last = angle;
+            self.turn.push(turned);
+        }
+        let mut from = 0;
+        (block.start - first..block.end - first).all(|c| {
+            let start = path.length_start(first, c, &mut from);
+            let before = start.checked_sub(1).map_or(0.0, |k| self.turn[k]);
+            (self.turn[c] - before).abs() < 4.0 - 1e-6
+        })
     }
 
     /// Whether chords `from ..= to` go all round `centre` (their ends' unwrapped angles a
@@ -617,6 +666,24 @@ mod tests {
         let found = search(&v);
         assert!(found.events.is_empty());
         assert_eq!(found.tested, 0);
+    }
+
+    /// A flat path that goes round twice in one layer, its radius swinging so that the second
+    /// round crosses the first: every chord goes round the same way, but a window goes round
+    /// more than once, so it is judged chord by chord and its crossings are found.
+    #[test]
+    fn going_round_twice_in_one_layer_is_judged_chord_by_chord() {
+        let v: Vec<DVec3> = (0..=1440)
+            .map(|k| {
+                let a = TAU * k as f64 / 720.0;
+                let r = 10.0 + 2.0 * (1.5 * a).sin();
+                DVec3::new(100.0 + r * a.cos(), 100.0 + r * a.sin(), 0.5)
+            })
+            .collect();
+        let found = search(&v);
+        assert!(found.complete);
+        assert!(!found.events.is_empty());
+        assert_eq!(found.events.len(), every_pair(&v));
     }
 
     #[test]
