@@ -663,8 +663,9 @@ impl<'a> BodyWriter<'a> {
         }
     }
 
+    /// The whole percent of the nominal time done by `t_done`, 0 … 100.
     fn percent(&self, t_done: f64) -> u64 {
-        ((t_done / self.nominal) * 100.0).floor().clamp(0.0, 100.0) as u64
+        whole_percent((t_done / self.nominal) * 100.0)
     }
 
     /// Writes points 1 .. n, chunk by chunk, two chunks at a time in parallel.
@@ -783,15 +784,16 @@ impl<'a> BodyWriter<'a> {
             told,
         } = piece;
         let mut line = Line::new();
-        // Each number written, and read back where the moves are wanted.
-        let number = |line: &mut Line, v: f64, decimals: u32| {
-            if want.moves {
-                line.fixed_read(v, decimals)
+        // Each number written, and read back where the moves are wanted (the decimals a
+        // constant: no dispatch on them at each number).
+        #[inline(always)]
+        fn number<const D: u32>(line: &mut Line, v: f64, read: bool) -> Option<f64> {
+            if read {
+                line.fixed_const::<D, true>(v)
             } else {
-                line.fixed(v, decimals);
-                None
+                line.fixed_const::<D, false>(v)
             }
-        };
+        }
         // Counts `count` lines at path point `point`.
         let mark = |lines: &mut usize, points: &mut Vec<u32>, count: usize, point: usize| {
             *lines += count;
@@ -839,17 +841,17 @@ impl<'a> BodyWriter<'a> {
             let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
             line.clear();
             line.text(b"G1 X");
-            let x = number(&mut line, q.pos.x - ox, 3);
+            let x = number::<3>(&mut line, q.pos.x - ox, want.moves);
             line.text(b" Y");
-            let y = number(&mut line, q.pos.y - oy, 3);
+            let y = number::<3>(&mut line, q.pos.y - oy, want.moves);
             line.text(b" Z");
-            let z = number(&mut line, q.pos.z, 3);
+            let z = number::<3>(&mut line, q.pos.z, want.moves);
             line.text(b" E");
             let e = match p.extrusion {
-                ExtrusionMode::Relative => number(&mut line, e, 5),
+                ExtrusionMode::Relative => number::<5>(&mut line, e, want.moves),
                 ExtrusionMode::Absolute => {
                     st.e_total += e;
-                    number(&mut line, st.e_total, 5)
+                    number::<5>(&mut line, st.e_total, want.moves)
                 }
             };
             if q.speed != st.last_speed {
@@ -857,7 +859,7 @@ impl<'a> BodyWriter<'a> {
                 st.last_speed = q.speed;
             }
             line.text(b"\n");
-            buf.extend_from_slice(line.as_bytes());
+            line.append_to(buf);
             mark(lines, points, 1, i);
             if want.moves {
                 // What the checker's reader makes of the line: X Y Z E as written.
@@ -873,6 +875,14 @@ impl<'a> BodyWriter<'a> {
         }
         *told &= want.moves;
     }
+}
+
+/// `⌊percent⌋` clamped to 0 … 100 (0 for NaN): the truncation of the clamped value, which is
+/// its floor there, with no call to the C library's `floor` (what the baseline x86-64 target
+/// makes of `f64::floor`), once a line.
+#[inline]
+fn whole_percent(percent: f64) -> u64 {
+    percent.clamp(0.0, 100.0) as u64
 }
 
 /// What the body's writer gives besides the text.
@@ -914,6 +924,20 @@ impl Piece {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    proptest::proptest! {
+        /// The whole percent is the floor of the percent, clamped, for any number.
+        #[test]
+        fn the_whole_percent_is_the_floor_clamped(
+            x in proptest::num::f64::ANY,
+            near in -2i32..103,
+            tiny in -1e-9..1e-9f64,
+        ) {
+            for x in [x, f64::from(near) + tiny, f64::from(near)] {
+                proptest::prop_assert_eq!(whole_percent(x), x.floor().clamp(0.0, 100.0) as u64);
+            }
+        }
+    }
 
     /// The path's length and its time at its own speeds, summed from the planner's moves, are
     /// the toolpath's own sums to the last bit (a spiral whose speeds change: its upper layers
