@@ -14,6 +14,8 @@ use glam::{DVec2, DVec3};
 const BIG_DESIGN: &str = include_str!("../../../assets/benchmarks/vase-720x300.toml");
 
 fn pipeline(c: &mut Criterion) {
+    // The heap as `clayloft gcode` sets it up (for every benchmark of this binary after).
+    clayloft_core::heap::tune_for_batch_command();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bench.gcode");
     let mut g = c.benchmark_group("pipeline");
