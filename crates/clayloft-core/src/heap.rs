@@ -103,15 +103,23 @@ mod tests {
 
     /// The second 20 MB buffer reuses the first one's memory, and so faults a few times, not
     /// 5 120. (By default glibc maps the first afresh and gives it back, raising its threshold;
-    /// the second then grows the heap, faulting every page again.)
+    /// the second then grows the heap, faulting every page again.) Tried three times: with one
+    /// heap for every thread, another test's thread may take the freed buffer in between.
     #[test]
     fn a_freed_buffer_is_reused_without_faulting_its_pages_again() {
         std::thread::spawn(|| {
             tune_for_batch_command();
-            let (_, first) = fill_and_free();
-            let (again, second) = fill_and_free();
-            assert_eq!(first, second, "the freed buffer was not reused");
-            assert!(again < 64, "{again} faults for a reused buffer");
+            let tries: Vec<_> = (0..3)
+                .map(|_| {
+                    let (_, first) = fill_and_free();
+                    let (again, second) = fill_and_free();
+                    (first == second, again)
+                })
+                .collect();
+            assert!(
+                tries.iter().any(|&(reused, again)| reused && again < 64),
+                "(reused, faults) {tries:?}"
+            );
         })
         .join()
         .unwrap();
