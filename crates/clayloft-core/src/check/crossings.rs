@@ -371,7 +371,8 @@ impl Work {
         let (mut turned, mut last) = (0.0, pseudo_angle_or_zero(around(chords[first].0)));
         for &(a, b) in &chords[first..block.end] {
             // Strictly one way round (not through the centre, not along a ray; no NaN).
-            if !(around(a).perp_dot(around(b)) * way > 0.0) {
+            let onward = around(a).perp_dot(around(b)) * way;
+            if onward.is_nan() || onward <= 0.0 {
                 return false;
             }
             let angle = pseudo_angle(around(b));
