@@ -13,7 +13,7 @@
 //! * glibc gives each new thread a heap of its own (an arena), so the memory one core frees is
 //!   not reused by the other, and the helper's buffers fault their pages in afresh; with one
 //!   arena (`M_ARENA_MAX`) both cores reuse it;
-//! * the heap is grown by [`HEAP_ROOM`] at once (`M_TOP_PAD`) and marked for transparent huge
+//! * the heap is grown by 96 MB at once (`M_TOP_PAD`) and marked for transparent huge
 //!   pages (`madvise(MADV_HUGEPAGE)`), so a first touch maps 2 MB, not 4 kB: the benchmark
 //!   vase's `clayloft gcode` takes about 1 000 page faults instead of 10 000, and its median
 //!   whole process went 136.5 → 126.7 ms, its processor time 260 → 242 ms
