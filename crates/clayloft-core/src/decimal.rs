@@ -48,6 +48,8 @@ impl Default for Line {
 
 impl Line {
     pub const CAPACITY: usize = 2048;
+    /// The bytes [`Line::append_to`] copies at once.
+    pub const COPIED: usize = 64;
 
     pub fn new() -> Self {
         Self {
@@ -81,9 +83,6 @@ impl Line {
             out.extend_from_slice(self.as_bytes());
         }
     }
-
-    /// The bytes [`Line::append_to`] copies at once.
-    pub const COPIED: usize = 64;
 
     /// Appends `text` (panics past [`Line::CAPACITY`]: a line is a few words).
     #[inline]

@@ -169,8 +169,9 @@ type PathPoints = (Vec<DVec3>, Vec<usize>);
 /// starts from and each move's end, in the bed frame (`shift` added), with each point's line;
 /// and the moves' tally (`tally` of a range of moves: see [`MoveTally`]). In two halves, one on
 /// a second core and one on this one, each copying its half of the path and tallying its half
-/// of the moves: the copy is mostly the new buffers' page faults (3.2 ms on one core for the
-/// benchmark vase's 7 MB), the tally a pass over every move.
+/// of the moves: the copy was mostly the new buffers' page faults (3.2 ms on one core for the
+/// benchmark vase's 7 MB, before batch commands took huge pages), the tally a pass over every
+/// move.
 fn extruding_path(
     moves: &[Move],
     start: DVec3,
