@@ -447,6 +447,43 @@ pub fn both<A: Send, B>(
     (out_a.expect("the helper ran a"), b)
 }
 
+/// `f(&mut state, k)` for every task k in `0..count`, the results in the order of k. The tasks
+/// are shared out as they go: this thread and every free helper take the next task not yet
+/// taken whenever they finish one, each with a `state` of its own from `init` (scratch space
+/// reused from task to task). For work whose cost varies along its range, where halves fixed in
+/// advance leave one core idle while the other finishes the harder half. The tasks' results
+/// must not depend on the state they find (nor on which thread ran them), so that the whole
+/// is the same however the tasks fell.
+pub fn map_shared<S, R: Send>(
+    count: usize,
+    init: impl Fn() -> S + Sync,
+    f: impl Fn(&mut S, usize) -> R + Sync,
+) -> Vec<R> {
+    let next = AtomicUsize::new(0);
+    let (next, init, f) = (&next, &init, &f);
+    let worker = move || {
+        let mut state = None;
+        let mut done = Vec::new();
+        loop {
+            let k = next.fetch_add(1, Ordering::Relaxed);
+            if k >= count {
+                return done;
+            }
+            let state = state.get_or_insert_with(init);
+            done.push((k, f(state, k)));
+        }
+    };
+    let workers = if count > 1 { cores().min(count) } else { 1 };
+    let mut results: Vec<Option<R>> = (0..count).map(|_| None).collect();
+    for (k, r) in run_parts(vec![worker; workers]).into_iter().flatten() {
+        results[k] = Some(r);
+    }
+    results
+        .into_iter()
+        .map(|r| r.expect("every task ran"))
+        .collect()
+}
+
 /// `f(offset, part)` on contiguous parts of `items`, one per core (`offset`: the index of the
 /// part's first item).
 pub fn for_each_part<T: Send>(
@@ -488,6 +525,45 @@ mod tests {
                 assert_eq!(v, (0..len).collect::<Vec<_>>());
             }
         }
+    }
+
+    /// Shared tasks come back in their order whoever took them, each run once, with each
+    /// thread's state reused from task to task; uneven tasks, tasks inside tasks, and none.
+    #[test]
+    fn shared_tasks_come_back_in_order_each_run_once() {
+        let runs = AtomicUsize::new(0);
+        let states = AtomicUsize::new(0);
+        awake(|| {
+            for count in [0, 1, 2, 3, 17, 200] {
+                runs.store(0, Ordering::Relaxed);
+                states.store(0, Ordering::Relaxed);
+                let got = map_shared(
+                    count,
+                    || {
+                        states.fetch_add(1, Ordering::Relaxed);
+                        Vec::<usize>::new()
+                    },
+                    |scratch, k| {
+                        runs.fetch_add(1, Ordering::Relaxed);
+                        scratch.push(k);
+                        // Early tasks cost far more than late ones.
+                        let spin = if k < 2 { 200_000 } else { 100 };
+                        let inner: u64 =
+                            map_shared(3, || (), |(), j| (0..spin).sum::<u64>() + j as u64)
+                                .into_iter()
+                                .sum();
+                        (k, inner)
+                    },
+                );
+                let spin_sum = |spin: u64| 3 * (0..spin).sum::<u64>() + 3;
+                let expected: Vec<(usize, u64)> = (0..count)
+                    .map(|k| (k, spin_sum(if k < 2 { 200_000 } else { 100 })))
+                    .collect();
+                assert_eq!(got, expected);
+                assert_eq!(runs.load(Ordering::Relaxed), count);
+                assert!(states.load(Ordering::Relaxed) <= cores().min(count.max(1)));
+            }
+        });
     }
 
     /// Parts handed to the helpers: results in order whoever runs them, parts started from

@@ -76,15 +76,18 @@ pub(super) struct CrossingLimits {
 
 /// The loops of path `v`, given as chords (`chords[c]` = points `i ..= k`, nearly straight;
 /// `usable(c)`: the chord is measured, inside the machine and not steep) with each point's
-/// G-code line in `lines` and the path's length up to each point in `cum`.
-pub(super) fn find_crossings(
+/// G-code line in `lines` and the path's length up to each point in `cum`; and `beside()`, work
+/// that needs the cores while the blocks are judged (the layer search's index), run as one more
+/// task among the blocks: the core that takes it goes on with the blocks once it is done.
+pub(super) fn find_crossings<T: Send>(
     v: &[DVec3],
     chords: &[(usize, usize)],
     lines: &[usize],
     cum: &[f64],
     limits: CrossingLimits,
     usable: &(impl Fn(usize) -> bool + Sync),
-) -> Crossings {
+    beside: impl FnOnce() -> T + Send,
+) -> (Crossings, T) {
     let n = chords.len();
     let blocks = n.div_ceil(BLOCK);
     let path = Path {
@@ -94,23 +97,32 @@ pub(super) fn find_crossings(
         limits,
         usable,
     };
-    let judged = crate::parallel::map_ranges(blocks, 2, |range| {
-        let mut work = Work::default();
-        range
-            .map(|b| {
-                let budget = TESTS_BASE.div_ceil(blocks.max(1))
-                    + TESTS_PER_CHORD * (BLOCK.min(n - b * BLOCK));
-                work.judge(&path, b * BLOCK..((b + 1) * BLOCK).min(n), budget)
-            })
-            .collect()
+    let beside = std::sync::Mutex::new(Some(beside));
+    let beside_done = std::sync::Mutex::new(None);
+    // Task 0 is `beside`, first so that it starts at once; task b + 1 judges block b. A block's
+    // cost varies tenfold (the belly's turns back), so the blocks are shared out as they go.
+    let judged = crate::parallel::map_shared(blocks + 1, Work::default, |work, task| {
+        let Some(b) = task.checked_sub(1) else {
+            let f = beside.lock().unwrap_or_else(|e| e.into_inner()).take();
+            let out = f.map(|f| f());
+            *beside_done.lock().unwrap_or_else(|e| e.into_inner()) = out;
+            return None;
+        };
+        let budget =
+            TESTS_BASE.div_ceil(blocks.max(1)) + TESTS_PER_CHORD * (BLOCK.min(n - b * BLOCK));
+        Some(work.judge(&path, b * BLOCK..((b + 1) * BLOCK).min(n), budget))
     });
+    let beside = beside_done
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner())
+        .expect("the task beside the blocks ran");
     let mut found = Crossings {
         tally: Tally::default(),
         events: Vec::new(),
         complete: true,
         tested: 0,
     };
-    for block in judged {
+    for block in judged.into_iter().flatten() {
         found.tested += block.tested;
         found.complete &= block.complete;
         for (value, c) in block.loops {
@@ -123,7 +135,7 @@ pub(super) fn find_crossings(
             });
         }
     }
-    found
+    (found, beside)
 }
 
 /// What the blocks read.
@@ -619,7 +631,7 @@ mod tests {
         for w in v.windows(2) {
             cum.push(cum.last().unwrap() + w[0].distance(w[1]));
         }
-        find_crossings(v, &chords, &lines, &cum, LIMITS, &|_| true)
+        find_crossings(v, &chords, &lines, &cum, LIMITS, &|_| true, || ()).0
     }
 
     /// A spiral of `turns` revolutions of radius 40 mm, 0.5 mm a revolution, `n` points each,

@@ -599,7 +599,8 @@ fn measure_layers_in(
         let (a, b) = (v[chords[id].0], v[chords[id].1]);
         inside(a) && inside(b) && !steep(a, b)
     };
-    let crossings = find_crossings(
+    // The loops, and beside them the index of the chords the layer search reads.
+    let (crossings, index) = find_crossings(
         v,
         &chords,
         lines,
@@ -610,24 +611,24 @@ fn measure_layers_in(
             reach: LOOP_REACH_BEADS * limits.line_width,
         },
         &usable,
+        || match search {
+            // The tree holds what the grid holds, and is never too large to build.
+            Search::Tree => Some(ChordIndex::Tree(ChordTree::build(v, &chords, &usable))),
+            // Columns twice the near box's half-width across: a point's near box spans 2 × 2
+            // of them mostly. Every chord goes into the grid first; a point's candidates are
+            // the chords that end at or before it (a prefix of each column's ascending list),
+            // so the points can be searched in any order, on every core.
+            _ => ChordGrid::build(
+                v,
+                &chords,
+                2.0 * near_radius,
+                &inside,
+                INSERTIONS_BASE.saturating_add(INSERTIONS_PER_CHORD.saturating_mul(chords.len())),
+                crate::parallel::PARALLEL_POINTS,
+            )
+            .map(ChordIndex::Grid),
+        },
     );
-    let index = match search {
-        // The tree holds what the grid holds, and is never too large to build.
-        Search::Tree => Some(ChordIndex::Tree(ChordTree::build(v, &chords, &usable))),
-        // Columns twice the near box's half-width across: a point's near box spans 2 × 2 of
-        // them mostly. Every chord goes into the grid first; a point's candidates are the
-        // chords that end at or before it (a prefix of each column's ascending list), so the
-        // points can be searched in any order, on every core.
-        _ => ChordGrid::build(
-            v,
-            &chords,
-            2.0 * near_radius,
-            &inside,
-            INSERTIONS_BASE.saturating_add(INSERTIONS_PER_CHORD.saturating_mul(chords.len())),
-            crate::parallel::PARALLEL_POINTS,
-        )
-        .map(ChordIndex::Grid),
-    };
     let mut measurable = index.is_some();
     let index = index.unwrap_or_else(|| {
         ChordIndex::Grid(ChordGrid {
@@ -1037,21 +1038,26 @@ struct LayerSearch<'a, F: Fn(DVec3) -> bool + Sync> {
     every_chord: bool,
 }
 
+/// Points a task of the layer search takes ([`LayerSearch::all`], [`LayerSearch::proves_all`]):
+/// the cost of a point varies along the path (the base, the belly's turns), so the points are
+/// shared out in runs as the cores get free, not in halves. A run's first point has no chord
+/// under the point before to start from: it is searched in full, one point in 4 096.
+const SEARCH_RUN: usize = 4096;
+
 impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
-    /// Every point, split over the machine's cores; each part gets its share of the budget.
+    /// Every point, in runs of [`SEARCH_RUN`] shared out over the machine's cores as they go;
+    /// each run gets its share of the budget.
     fn all(&self, budget: usize) -> Vec<Below> {
         let n = self.v.len();
-        let threads = crate::parallel::cores().clamp(1, 8);
-        if threads < 2 || n < crate::parallel::PARALLEL_POINTS {
+        if crate::parallel::cores() < 2 || n < crate::parallel::PARALLEL_POINTS {
             return self.range(0..n, budget);
         }
-        let chunk = n.div_ceil(threads);
-        let share = budget / threads;
-        crate::parallel::run_parts(
-            (0..n)
-                .step_by(chunk)
-                .map(|start| move || self.range(start..(start + chunk).min(n), share))
-                .collect(),
+        let runs = n.div_ceil(SEARCH_RUN);
+        let share = budget / runs;
+        crate::parallel::map_shared(
+            runs,
+            || (),
+            |(), k| self.range(k * SEARCH_RUN..((k + 1) * SEARCH_RUN).min(n), share),
         )
         .into_iter()
         .flatten()
@@ -1080,20 +1086,25 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
     /// [`LayerSearch::proves`]); on every core, each part with its share of `budget`.
     fn proves_all(&self, budget: usize, limits: LayerLimits) -> bool {
         let n = self.v.len();
-        let threads = crate::parallel::cores().clamp(1, 8);
-        if threads < 2 || n < crate::parallel::PARALLEL_POINTS {
+        if crate::parallel::cores() < 2 || n < crate::parallel::PARALLEL_POINTS {
             return self.proves(0..n, budget, limits);
         }
-        let chunk = n.div_ceil(threads);
-        let share = budget / threads;
-        crate::parallel::run_parts(
-            (0..n)
-                .step_by(chunk)
-                .map(|start| move || self.proves(start..(start + chunk).min(n), share, limits))
-                .collect(),
-        )
-        .into_iter()
-        .all(|holds| holds)
+        let runs = n.div_ceil(SEARCH_RUN);
+        let share = budget / runs;
+        // Once a run is not shown, the others need not be tried.
+        let failed = std::sync::atomic::AtomicBool::new(false);
+        let shown = |k: usize| {
+            use std::sync::atomic::Ordering::Relaxed;
+            let shown = !failed.load(Relaxed)
+                && self.proves(k * SEARCH_RUN..((k + 1) * SEARCH_RUN).min(n), share, limits);
+            if !shown {
+                failed.store(true, Relaxed);
+            }
+            shown
+        };
+        crate::parallel::map_shared(runs, || (), |(), k| shown(k))
+            .into_iter()
+            .all(|holds| holds)
     }
 
     /// Whether points `range` keep `limits` (the layer they rest on neither too thin nor too
