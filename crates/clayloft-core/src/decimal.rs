@@ -1,11 +1,13 @@
 //! Decimal text of G-code numbers: fixed-point, rounded half away from zero, written three
-//! digits (or two) at a time into a line assembled on the stack; and read back ([`parse_f64`],
-//! [`decimal_prefix`]).
+//! digits (or two) at a time straight into the output's spare room ([`Line`]); and read back
+//! ([`parse_f64`], [`decimal_prefix`]).
 //!
 //! A path point's line is about 40 bytes and five numbers; writing it word by word into the
 //! output costs a capacity check and a copy call per word, and a division by a power of ten that
 //! the compiler only turns into a multiplication when the power is known. [`Line`] knows it (the
-//! decimals are a constant at every call) and is appended to the output in one copy.
+//! decimals are a constant at every call) and writes into room reserved once a line.
+
+use std::mem::MaybeUninit;
 
 /// Two-digit pairs "00" … "99", for writing integers two digits per division.
 const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
@@ -31,63 +33,44 @@ const TRIPLES: [u32; 1000] = {
 /// Most decimals a number is written with (`10^MAX_DECIMALS` fits the fast path's integers).
 pub const MAX_DECIMALS: u32 = 6;
 
-/// One line of text assembled in a fixed buffer: numbers and words are written into it, then it
-/// is appended to the output in one copy. Room for any line of [`Line::CAPACITY`] bytes: five
-/// numbers of any `f64` at up to [`MAX_DECIMALS`] decimals (at most 317 characters each, for
-/// `-1.8e308`) and their words.
-pub struct Line {
-    bytes: [u8; Line::CAPACITY],
+/// One line of text written straight into the spare room at the end of an output buffer
+/// ([`Line::append`]), which holds any line of [`Line::CAPACITY`] bytes: five numbers of any
+/// `f64` at up to [`MAX_DECIMALS`] decimals (at most 317 characters each, for `-1.8e308`) and
+/// their words.
+///
+/// Written in place, a line is never read back: a line assembled on the stack and then copied
+/// was read in wide loads from the narrow stores just made, which the processor cannot forward
+/// and waits for (about half the writer's time here, sampled).
+pub struct Line<'a> {
+    /// The output's room past its end, [`Line::CAPACITY`] bytes; the first `len` written.
+    room: &'a mut [MaybeUninit<u8>],
     len: usize,
 }
 
-impl Default for Line {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Line {
+impl Line<'_> {
     pub const CAPACITY: usize = 2048;
-    /// The bytes [`Line::append_to`] copies at once.
-    pub const COPIED: usize = 64;
 
-    pub fn new() -> Self {
-        Self {
-            bytes: [0; Self::CAPACITY],
+    /// Writes a line at the end of `out` with `write`, and gives what `write` gives.
+    #[inline(always)]
+    pub fn append<R>(out: &mut Vec<u8>, write: impl FnOnce(&mut Line<'_>) -> R) -> R {
+        out.reserve(Self::CAPACITY);
+        let mut line = Line {
+            room: &mut out.spare_capacity_mut()[..Self::CAPACITY],
             len: 0,
-        }
-    }
-
-    /// Empties the line (the buffer is reused).
-    #[inline]
-    pub fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// The text so far.
-    #[inline]
-    pub fn as_bytes(&self) -> &[u8] {
-        &self.bytes[..self.len]
-    }
-
-    /// Appends the line's text to `out`. A line of up to [`Line::COPIED`] bytes (every `G1` of
-    /// a path) goes as that many bytes at once, the rest cut off again: a copy of known size,
-    /// made in a few instructions, instead of a call to `memcpy` for a few dozen bytes.
-    #[inline]
-    pub fn append_to(&self, out: &mut Vec<u8>) {
-        if self.len <= Self::COPIED {
-            let at = out.len();
-            out.extend_from_slice(&self.bytes[..Self::COPIED]);
-            out.truncate(at + self.len);
-        } else {
-            out.extend_from_slice(self.as_bytes());
-        }
+        };
+        let result = write(&mut line);
+        let len = line.len;
+        // SAFETY: `len` is at most the room's length, within the spare capacity, and every byte
+        // below it was written: each write sets the bytes from `len` on before moving `len` past
+        // them (a word may set bytes past its width, never fewer).
+        unsafe { out.set_len(out.len() + len) };
+        result
     }
 
     /// Appends `text` (panics past [`Line::CAPACITY`]: a line is a few words).
     #[inline]
     pub fn text(&mut self, text: &[u8]) -> &mut Self {
-        self.bytes[self.len..self.len + text.len()].copy_from_slice(text);
+        self.room[self.len..self.len + text.len()].write_copy_of_slice(text);
         self.len += text.len();
         self
     }
@@ -182,24 +165,23 @@ impl Line {
     /// Appends the first `width` (at most 4) bytes of `word`, lowest first.
     #[inline]
     fn word(&mut self, word: u32, width: usize) {
-        self.bytes[self.len..self.len + 4].copy_from_slice(&word.to_le_bytes());
+        self.room[self.len..self.len + 4].write_copy_of_slice(&word.to_le_bytes());
         self.len += width;
     }
 
     /// Appends the last `width` decimal digits of `n` (zero-padded).
     #[inline]
     fn digits(&mut self, mut n: u64, width: usize) {
-        let out = &mut self.bytes[self.len..self.len + width];
+        let out = &mut self.room[self.len..self.len + width];
         let mut i = width;
         while i >= 2 {
             let pair = (n % 100) as usize * 2;
             n /= 100;
             i -= 2;
-            out[i] = DIGIT_PAIRS[pair];
-            out[i + 1] = DIGIT_PAIRS[pair + 1];
+            out[i..i + 2].write_copy_of_slice(&DIGIT_PAIRS[pair..pair + 2]);
         }
         if i == 1 {
-            out[0] = b'0' + (n % 10) as u8;
+            out[0].write(b'0' + (n % 10) as u8);
         }
         self.len += width;
     }
@@ -292,8 +274,9 @@ const POWERS_OF_TEN: [u64; 20] = {
 
 /// Appends `v` with exactly `decimals` digits after the point to `buf` (see [`Line::fixed`]).
 pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
-    let mut line = Line::new();
-    buf.extend_from_slice(line.fixed(v, decimals).as_bytes());
+    Line::append(buf, |line| {
+        line.fixed(v, decimals);
+    });
 }
 
 #[cfg(test)]
@@ -340,15 +323,17 @@ mod tests {
         /// A line of five numbers is the numbers' texts one after another, whatever they are.
         #[test]
         fn a_line_is_its_words_in_order(vs in proptest::collection::vec(proptest::num::f64::ANY, 5)) {
-            let mut line = Line::new();
+            let mut out = Vec::new();
             let mut words = String::new();
-            for (k, &v) in vs.iter().enumerate() {
-                let d = [3, 3, 3, 5, 1][k];
-                line.text(b" W").fixed(v, d);
-                words.push_str(" W");
-                words.push_str(&fixed_by_round(v, d));
-            }
-            proptest::prop_assert_eq!(std::str::from_utf8(line.as_bytes()).unwrap(), words);
+            Line::append(&mut out, |line| {
+                for (k, &v) in vs.iter().enumerate() {
+                    let d = [3, 3, 3, 5, 1][k];
+                    line.text(b" W").fixed(v, d);
+                    words.push_str(" W");
+                    words.push_str(&fixed_by_round(v, d));
+                }
+            });
+            proptest::prop_assert_eq!(std::str::from_utf8(&out).unwrap(), words);
         }
 
         /// The number a text is told to read as is what the reader and the standard parser
@@ -363,10 +348,10 @@ mod tests {
         ) {
             let edge = 2f64.powi(53) / 10f64.powi(d as i32);
             for x in [v, small, -small * 1e-7, half as f64 + 0.5, (half as f64 + 0.5) / 10f64.powi(d as i32), edge, edge.next_down(), -0.0, 9.0e18] {
-                let mut line = Line::new();
-                let told = line.fixed_read(x, d);
-                let text = std::str::from_utf8(line.as_bytes()).unwrap();
-                let read = decimal_prefix(line.as_bytes()).filter(|&(_, used)| used == text.len());
+                let mut out = Vec::new();
+                let told = Line::append(&mut out, |line| line.fixed_read(x, d));
+                let text = std::str::from_utf8(&out).unwrap();
+                let read = decimal_prefix(&out).filter(|&(_, used)| used == text.len());
                 match told {
                     Some(t) => {
                         let (r, _) = read.expect("a plain decimal");
@@ -439,33 +424,43 @@ mod tests {
         assert!(parse_f64(".").is_err() && parse_f64("").is_err() && parse_f64("1.2.3").is_err());
     }
 
-    /// A line appended gives its text and nothing more, whether it is copied at once (up to
-    /// `Line::COPIED` bytes) or not, after what the output held.
+    /// A line appended gives its text and nothing more after what the output held, whether
+    /// the output had room for it or grew, and the room past it is not the output's.
     #[test]
     fn a_line_appends_its_text_only() {
         let mut out = b"before;".to_vec();
         let mut want = out.clone();
-        let mut line = Line::new();
-        let copied = Line::COPIED;
-        for len in [0, 1, 37, copied - 1, copied, copied + 1, 300] {
-            line.clear();
+        for len in [0, 1, 3, 4, 5, 37, 64, 300, Line::CAPACITY] {
             let text: Vec<u8> = (0..len).map(|k| b'a' + (k % 26) as u8).collect();
-            line.text(&text);
-            line.append_to(&mut out);
+            Line::append(&mut out, |line| {
+                line.text(&text);
+            });
             want.extend_from_slice(&text);
+            assert_eq!(out, want, "{len}");
+            // Words of four bytes that keep fewer: only the kept bytes are the output's.
+            Line::append(&mut out, |line| {
+                line.word(u32::from_le_bytes(*b"WXYZ"), 1);
+                line.word(u32::from_le_bytes(*b"wxyz"), 2);
+            });
+            want.extend_from_slice(b"Wwx");
             assert_eq!(out, want, "{len}");
         }
     }
 
     #[test]
     fn the_longest_line_fits() {
-        let mut line = Line::new();
-        line.text(b"G1 X");
-        for d in [3, 3, 3, MAX_DECIMALS, MAX_DECIMALS] {
-            line.fixed(-f64::MAX, d).text(b" E");
-        }
-        assert!(line.as_bytes().len() <= Line::CAPACITY);
-        line.clear();
-        assert_eq!(line.fixed(-0.0, 3).as_bytes(), b"0.000");
+        let mut out = Vec::new();
+        Line::append(&mut out, |line| {
+            line.text(b"G1 X");
+            for d in [3, 3, 3, MAX_DECIMALS, MAX_DECIMALS] {
+                line.fixed(-f64::MAX, d).text(b" E");
+            }
+        });
+        assert!(out.len() <= Line::CAPACITY);
+        out.clear();
+        Line::append(&mut out, |line| {
+            line.fixed(-0.0, 3);
+        });
+        assert_eq!(out, b"0.000");
     }
 }

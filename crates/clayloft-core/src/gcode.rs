@@ -783,11 +783,10 @@ impl<'a> BodyWriter<'a> {
             moves,
             told,
         } = piece;
-        let mut line = Line::new();
         // Each number written, and read back where the moves are wanted (the decimals a
         // constant: no dispatch on them at each number).
         #[inline(always)]
-        fn number<const D: u32>(line: &mut Line, v: f64, read: bool) -> Option<f64> {
+        fn number<const D: u32>(line: &mut Line<'_>, v: f64, read: bool) -> Option<f64> {
             if read {
                 line.fixed_const::<D, true>(v)
             } else {
@@ -839,27 +838,29 @@ impl<'a> BodyWriter<'a> {
             let prev = &tp.points[i - 1];
             st.t_done += prev.pos.distance(q.pos) / q.speed;
             let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
-            line.clear();
-            line.text(b"G1 X");
-            let x = number::<3>(&mut line, q.pos.x - ox, want.moves);
-            line.text(b" Y");
-            let y = number::<3>(&mut line, q.pos.y - oy, want.moves);
-            line.text(b" Z");
-            let z = number::<3>(&mut line, q.pos.z, want.moves);
-            line.text(b" E");
-            let e = match p.extrusion {
-                ExtrusionMode::Relative => number::<5>(&mut line, e, want.moves),
-                ExtrusionMode::Absolute => {
-                    st.e_total += e;
-                    number::<5>(&mut line, st.e_total, want.moves)
+            let (x, y, z, e) = Line::append(buf, |line| {
+                line.text(b"G1 X");
+                let x = number::<3>(line, q.pos.x - ox, want.moves);
+                line.text(b" Y");
+                let y = number::<3>(line, q.pos.y - oy, want.moves);
+                line.text(b" Z");
+                let z = number::<3>(line, q.pos.z, want.moves);
+                line.text(b" E");
+                let e = match p.extrusion {
+                    ExtrusionMode::Relative => number::<5>(line, e, want.moves),
+                    ExtrusionMode::Absolute => {
+                        st.e_total += e;
+                        number::<5>(line, st.e_total, want.moves)
+                    }
+                };
+                if q.speed != st.last_speed {
+                    line.text(b" F");
+                    number::<1>(line, q.speed * 60.0, false);
+                    st.last_speed = q.speed;
                 }
-            };
-            if q.speed != st.last_speed {
-                line.text(b" F").fixed(q.speed * 60.0, 1);
-                st.last_speed = q.speed;
-            }
-            line.text(b"\n");
-            line.append_to(buf);
+                line.text(b"\n");
+                (x, y, z, e)
+            });
             mark(lines, points, 1, i);
             if want.moves {
                 // What the checker's reader makes of the line: X Y Z E as written.
