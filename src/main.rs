@@ -243,6 +243,7 @@ fn default_design() -> PathBuf {
 /// Loads a design and runs the pipeline, with errors located in the file.
 fn job_of(path: &Path, printer: Option<&str>) -> Result<(LoadedDesign, PrintJob), Failure> {
     let loaded = clayloft_core::load::load_design_using(path, printer)?;
+    clayloft_core::heap::fault_ahead_for(&loaded.design);
     let job = clayloft_core::run(&loaded.design).map_err(|e| loaded.locate(e))?;
     Ok((loaded, job))
 }

@@ -111,10 +111,11 @@ impl Helper {
                 continue;
             }
             spins = spins.wrapping_add(1);
-            if pool().awake.load(Ordering::Relaxed) > 0
-                || !spins.is_multiple_of(64)
-                || last.elapsed() < LINGER
-            {
+            let awake = pool().awake.load(Ordering::Relaxed) > 0;
+            if awake && spins.is_multiple_of(64) && IDLE_FAULT.step() {
+                continue;
+            }
+            if awake || !spins.is_multiple_of(64) || last.elapsed() < LINGER {
                 std::hint::spin_loop();
             } else {
                 std::thread::park();
@@ -290,6 +291,58 @@ pub fn fault_in_spare<T>(v: &Vec<T>) -> Beside<()> {
         }
         None => Beside::done(),
     }
+}
+
+/// Memory that idle helpers fault in ahead of use ([`fault_in_while_idle`]): from `next` to
+/// `end`, a step at a time.
+struct IdleFault {
+    next: AtomicUsize,
+    end: AtomicUsize,
+}
+
+/// What one idle moment of a helper faults in: a huge page (2 MB on x86-64), about 100 µs of
+/// zeroing here, so that a part handed over meanwhile waits no longer than that.
+const IDLE_FAULT_STEP: usize = 2 << 20;
+
+static IDLE_FAULT: IdleFault = IdleFault {
+    next: AtomicUsize::new(0),
+    end: AtomicUsize::new(0),
+};
+
+impl IdleFault {
+    /// Faults in the next step, if any is left (up to the next multiple of the step, so that
+    /// no page straddles two steps); whether it did.
+    fn step(&self) -> bool {
+        let end = self.end.load(Ordering::Relaxed);
+        let mut at = self.next.load(Ordering::Relaxed);
+        while at < end {
+            let to = (at + 1).next_multiple_of(IDLE_FAULT_STEP).min(end);
+            match self
+                .next
+                .compare_exchange_weak(at, to, Ordering::Relaxed, Ordering::Relaxed)
+            {
+                Ok(_) => {
+                    populate(at..to);
+                    return true;
+                }
+                Err(now) => at = now,
+            }
+        }
+        false
+    }
+}
+
+/// Has the helpers fault in the pages of `range` (heap that this process is about to fill)
+/// whenever they wait for work inside [`awake`], a step at a time from its start, so that the
+/// pages' first writes find them mapped and zeroed: on the calling thread a first write costs
+/// the kernel's zeroing of the page (a few milliseconds for a batch command's heap), which an
+/// idle core can do ahead of it. Only a hint, like [`fault_in_spare`]: the contents are never
+/// touched, and memory freed or never used meanwhile is only mapped. Replaces any range given
+/// before.
+pub fn fault_in_while_idle(range: Range<usize>) {
+    IDLE_FAULT.end.store(0, Ordering::Relaxed);
+    IDLE_FAULT.next.store(range.start, Ordering::Relaxed);
+    IDLE_FAULT.end.store(range.end, Ordering::Relaxed);
 }
 
 /// Maps the whole pages within the addresses `range` writable, as a write to each would,
@@ -678,5 +731,42 @@ mod tests {
         faulted.join();
         w.extend(0..(1 << 19));
         assert_eq!((w[0], w[1000], w.len()), (7, 999, 1001 + (1 << 19)));
+    }
+
+    /// Memory given to [`fault_in_while_idle`] is mapped by a helper while this thread works
+    /// inside [`awake`], and what it holds stays.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn idle_helpers_fault_memory_in_ahead_of_use() {
+        if cores() < 2 {
+            return;
+        }
+        let page = 4096;
+        let bytes = 8 << 20;
+        let resident = |v: &Vec<u64>| {
+            let first = (v.as_ptr() as usize).next_multiple_of(page);
+            let mut flags = vec![0u8; bytes / page - 1];
+            // SAFETY: the range lies in `v`'s block; mincore only fills `flags`.
+            let rc = unsafe {
+                libc::mincore(first as *mut libc::c_void, bytes - page, flags.as_mut_ptr())
+            };
+            assert_eq!(rc, 0);
+            flags.iter().filter(|&&f| f & 1 == 1).count()
+        };
+        let range = |v: &Vec<u64>| v.as_ptr() as usize..v.as_ptr() as usize + bytes;
+        let mut v: Vec<u64> = Vec::with_capacity(bytes / 8);
+        v.extend(0..1000);
+        fault_in_while_idle(range(&v));
+        let started = Instant::now();
+        let mapped = awake(|| {
+            // This thread's own work meanwhile (the helpers wait for none).
+            while resident(&v) < bytes / page - 1 && started.elapsed() < Duration::from_secs(5) {
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            resident(&v)
+        });
+        fault_in_while_idle(0..0);
+        assert_eq!(mapped, bytes / page - 1);
+        assert!(v.iter().copied().eq(0..1000));
     }
 }
