@@ -698,31 +698,77 @@ mod tests {
         assert_eq!(beside(|| 7).join(), 7);
     }
 
+    /// A block of fresh memory straight from the system (none of it in memory yet), whatever
+    /// the heap holds (other tests' freed buffers, once a test tunes the heap).
+    #[cfg(target_os = "linux")]
+    struct Fresh {
+        at: usize,
+        bytes: usize,
+    }
+
+    #[cfg(target_os = "linux")]
+    impl Fresh {
+        fn new(bytes: usize) -> Fresh {
+            // SAFETY: an anonymous private mapping, owned by the value and unmapped on drop.
+            let at = unsafe {
+                libc::mmap(
+                    std::ptr::null_mut(),
+                    bytes,
+                    libc::PROT_READ | libc::PROT_WRITE,
+                    libc::MAP_PRIVATE | libc::MAP_ANONYMOUS,
+                    -1,
+                    0,
+                )
+            };
+            assert_ne!(at, libc::MAP_FAILED);
+            Fresh {
+                at: at as usize,
+                bytes,
+            }
+        }
+
+        /// Its first `n` words.
+        fn words(&mut self, n: usize) -> &mut [u64] {
+            assert!(n * 8 <= self.bytes);
+            // SAFETY: the mapping is this value's, writable, page-aligned and `bytes` long.
+            unsafe { std::slice::from_raw_parts_mut(self.at as *mut u64, n) }
+        }
+
+        /// Its pages in memory, as `mincore` sees them.
+        fn resident(&self) -> usize {
+            let mut flags = vec![0u8; self.bytes.div_ceil(4096)];
+            // SAFETY: the range is this value's mapping; mincore only fills `flags`.
+            let rc = unsafe {
+                libc::mincore(self.at as *mut libc::c_void, self.bytes, flags.as_mut_ptr())
+            };
+            assert_eq!(rc, 0);
+            flags.iter().filter(|&&f| f & 1 == 1).count()
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    impl Drop for Fresh {
+        fn drop(&mut self) {
+            // SAFETY: the mapping made in `new`, no longer borrowed.
+            unsafe { libc::munmap(self.at as *mut libc::c_void, self.bytes) };
+        }
+    }
+
     /// Populating maps every whole page of a fresh block (as `mincore` sees it) and leaves the
     /// bytes written before it as they were; the buffer filled afterwards reads back.
     #[cfg(target_os = "linux")]
     #[test]
     fn populated_pages_are_mapped_and_keep_their_contents() {
-        let page = 4096;
-        // 16 MiB: the C library maps a block this large on its own, not yet in memory.
-        let mut v: Vec<u64> = Vec::with_capacity(2 << 20);
-        v.extend(0..1000);
-        let addr = v.as_ptr() as usize;
-        let (first, bytes) = (addr.next_multiple_of(page), (16 << 20) - page);
-        let resident = || {
-            let mut flags = vec![0u8; bytes / page];
-            // SAFETY: the range lies in `v`'s block; mincore only fills `flags`.
-            let rc =
-                unsafe { libc::mincore(first as *mut libc::c_void, bytes, flags.as_mut_ptr()) };
-            assert_eq!(rc, 0);
-            flags.iter().filter(|&&f| f & 1 == 1).count()
-        };
-        let before = resident();
-        populate(addr..addr + (16 << 20));
-        let after = resident();
-        assert!(before < bytes / page / 2, "{before} pages in memory before");
-        assert_eq!(after, bytes / page);
-        assert!(v.iter().copied().eq(0..1000));
+        let pages = 4096;
+        let mut block = Fresh::new(pages * 4096);
+        block.words(1000).iter_mut().zip(0..).for_each(|(w, k)| *w = k);
+        let before = block.resident();
+        // From inside the first page to inside the last: the whole pages between are mapped.
+        populate(block.at + 100..block.at + block.bytes - 100);
+        let after = block.resident();
+        assert!(before < pages / 2, "{before} pages in memory before");
+        assert!(after >= pages - 2, "{after} pages in memory after");
+        assert!(block.words(1000).iter().copied().eq(0..1000));
         // Faulted in beside (or not, when no helper is free): the buffer fills as ever.
         let mut w: Vec<u64> = Vec::with_capacity(1 << 20);
         w.push(7);
@@ -741,32 +787,21 @@ mod tests {
         if cores() < 2 {
             return;
         }
-        let page = 4096;
-        let bytes = 8 << 20;
-        let resident = |v: &Vec<u64>| {
-            let first = (v.as_ptr() as usize).next_multiple_of(page);
-            let mut flags = vec![0u8; bytes / page - 1];
-            // SAFETY: the range lies in `v`'s block; mincore only fills `flags`.
-            let rc = unsafe {
-                libc::mincore(first as *mut libc::c_void, bytes - page, flags.as_mut_ptr())
-            };
-            assert_eq!(rc, 0);
-            flags.iter().filter(|&&f| f & 1 == 1).count()
-        };
-        let range = |v: &Vec<u64>| v.as_ptr() as usize..v.as_ptr() as usize + bytes;
-        let mut v: Vec<u64> = Vec::with_capacity(bytes / 8);
-        v.extend(0..1000);
-        fault_in_while_idle(range(&v));
+        let pages = 2048;
+        let mut block = Fresh::new(pages * 4096);
+        block.words(1000).iter_mut().zip(0..).for_each(|(w, k)| *w = k);
+        assert!(block.resident() < pages / 2);
+        fault_in_while_idle(block.at..block.at + block.bytes);
         let started = Instant::now();
         let mapped = awake(|| {
             // This thread's own work meanwhile (the helpers wait for none).
-            while resident(&v) < bytes / page - 1 && started.elapsed() < Duration::from_secs(5) {
+            while block.resident() < pages && started.elapsed() < Duration::from_secs(5) {
                 std::thread::sleep(Duration::from_millis(1));
             }
-            resident(&v)
+            block.resident()
         });
         fault_in_while_idle(0..0);
-        assert_eq!(mapped, bytes / page - 1);
-        assert!(v.iter().copied().eq(0..1000));
+        assert_eq!(mapped, pages);
+        assert!(block.words(1000).iter().copied().eq(0..1000));
     }
 }
