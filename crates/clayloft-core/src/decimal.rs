@@ -30,6 +30,19 @@ const TRIPLES: [u32; 1000] = {
     t
 };
 
+/// The digits of 0 … 999 without leading zeros, lowest first in the low three bytes, and
+/// their count in the top byte ("7" is `b'7' | 1 << 24`): the whole part of a number in one load.
+const WHOLES: [u32; 1000] = {
+    let mut t = [0u32; 1000];
+    let mut i = 0;
+    while i < 1000 {
+        let width = 1 + (i >= 10) as u32 + (i >= 100) as u32;
+        t[i] = TRIPLES[i] >> (8 * (3 - width)) | width << 24;
+        i += 1;
+    }
+    t
+};
+
 /// Most decimals a number is written with (`10^MAX_DECIMALS` fits the fast path's integers).
 pub const MAX_DECIMALS: u32 = 6;
 
@@ -41,36 +54,53 @@ pub const MAX_DECIMALS: u32 = 6;
 /// Written in place, a line is never read back: a line assembled on the stack and then copied
 /// was read in wide loads from the narrow stores just made, which the processor cannot forward
 /// and waits for (about half the writer's time here, sampled).
+///
+/// The room is [`Line::CAPACITY`] bytes and a word more, and a write goes to the line's length
+/// taken modulo the capacity (a power of two): a word or a short constant written there lies
+/// in the room whatever the length, so the compiler checks no bounds for it. A line never
+/// reaches the capacity (tested with the longest numbers); one that did would panic in
+/// [`Line::append`], never write outside the room.
 pub struct Line<'a> {
-    /// The output's room past its end, [`Line::CAPACITY`] bytes; the first `len` written.
-    room: &'a mut [MaybeUninit<u8>],
+    /// The output's room past its end; the first `len` bytes written.
+    room: &'a mut [MaybeUninit<u8>; Line::ROOM],
     len: usize,
 }
 
 impl Line<'_> {
     pub const CAPACITY: usize = 2048;
+    /// The capacity and the longest write of a constant length (a word, a G-code word's
+    /// letters), which may start just below the capacity.
+    const ROOM: usize = Self::CAPACITY + 8;
 
     /// Writes a line at the end of `out` with `write`, and gives what `write` gives.
     #[inline(always)]
     pub fn append<R>(out: &mut Vec<u8>, write: impl FnOnce(&mut Line<'_>) -> R) -> R {
-        out.reserve(Self::CAPACITY);
-        let mut line = Line {
-            room: &mut out.spare_capacity_mut()[..Self::CAPACITY],
-            len: 0,
-        };
+        out.reserve(Self::ROOM);
+        let room = (&mut out.spare_capacity_mut()[..Self::ROOM])
+            .try_into()
+            .expect("the room reserved");
+        let mut line = Line { room, len: 0 };
         let result = write(&mut line);
         let len = line.len;
-        // SAFETY: `len` is at most the room's length, within the spare capacity, and every byte
-        // below it was written: each write sets the bytes from `len` on before moving `len` past
-        // them (a word may set bytes past its width, never fewer).
+        assert!(len <= Self::CAPACITY, "a line of {len} bytes");
+        // SAFETY: `len` is within the spare capacity, and every byte below it was written: each
+        // write sets the bytes from `len` on before moving `len` past them (a word may set bytes
+        // past its width, never fewer), and below the capacity the length modulo it is itself.
         unsafe { out.set_len(out.len() + len) };
         result
     }
 
-    /// Appends `text` (panics past [`Line::CAPACITY`]: a line is a few words).
+    /// Where the next byte goes (see [`Line`]).
+    #[inline(always)]
+    fn at(&self) -> usize {
+        self.len & (Self::CAPACITY - 1)
+    }
+
+    /// Appends `text` (panics past the room: a line is a few words).
     #[inline]
     pub fn text(&mut self, text: &[u8]) -> &mut Self {
-        self.room[self.len..self.len + text.len()].write_copy_of_slice(text);
+        let at = self.at();
+        self.room[at..at + text.len()].write_copy_of_slice(text);
         self.len += text.len();
         self
     }
@@ -115,15 +145,18 @@ impl Line<'_> {
     pub(crate) fn fixed_const<const D: u32, const READ: bool>(&mut self, v: f64) -> Option<f64> {
         let pow = 10u64.pow(D);
         let x = v.abs() * pow as f64;
-        // Out of range for integer formatting (never for a real printer), or not a number.
-        if !x.is_finite() || x >= 9.0e18 {
+        // Out of range for integer formatting (never for a real printer), or not a number (x is
+        // not below anything then; it is never negative).
+        if !(x < 9.0e18) {
             self.text(format!("{v:.*}", D as usize).as_bytes());
             return None;
         }
         // `x.round()` (half away from zero) without the library call the baseline x86-64 target
         // makes of it: below 2⁵³ the fraction `x − ⌊x⌋` is exact, above it x is whole.
         // Through i64 (x < 2⁶³): one conversion instruction each way.
-        let whole = x as i64;
+        // SAFETY: x is a number from 0 to below 9e18, so its whole part fits an i64 (the
+        // checked `as` would test for NaN and both ends again).
+        let whole: i64 = unsafe { x.to_int_unchecked() };
         let n = (whole + i64::from(x - whole as f64 >= 0.5)) as u64;
         let negative = v < 0.0 && n != 0;
         if negative {
@@ -131,9 +164,9 @@ impl Line<'_> {
         }
         let int = n / pow;
         if int < 1000 {
-            // One to three digits from one entry, the leading zeros shifted out.
-            let width = 1 + usize::from(int >= 10) + usize::from(int >= 100);
-            self.word(TRIPLES[int as usize] >> (8 * (3 - width)), width);
+            // One to three digits and their count from one entry.
+            let entry = WHOLES[int as usize];
+            self.word(entry & 0xff_ffff, (entry >> 24) as usize);
         } else {
             self.digits(int, int.checked_ilog10().map_or(1, |d| d as usize + 1));
         }
@@ -165,14 +198,16 @@ impl Line<'_> {
     /// Appends the first `width` (at most 4) bytes of `word`, lowest first.
     #[inline]
     fn word(&mut self, word: u32, width: usize) {
-        self.room[self.len..self.len + 4].write_copy_of_slice(&word.to_le_bytes());
+        let at = self.at();
+        self.room[at..at + 4].write_copy_of_slice(&word.to_le_bytes());
         self.len += width;
     }
 
     /// Appends the last `width` decimal digits of `n` (zero-padded).
     #[inline]
     fn digits(&mut self, mut n: u64, width: usize) {
-        let out = &mut self.room[self.len..self.len + width];
+        let at = self.at();
+        let out = &mut self.room[at..at + width];
         let mut i = width;
         while i >= 2 {
             let pair = (n % 100) as usize * 2;

@@ -665,7 +665,12 @@ impl<'a> BodyWriter<'a> {
 
     /// The whole percent of the nominal time done by `t_done`, 0 … 100.
     fn percent(&self, t_done: f64) -> u64 {
-        whole_percent((t_done / self.nominal) * 100.0)
+        percent_done(t_done, self.nominal)
+    }
+
+    /// See [`time_below_next_percent`].
+    fn percent_below(&self, percent: u64) -> f64 {
+        time_below_next_percent(percent, self.nominal)
     }
 
     /// Writes points 1 .. n, chunk by chunk, two chunks at a time in parallel.
@@ -800,9 +805,15 @@ impl<'a> BodyWriter<'a> {
                 points.extend(std::iter::repeat_n(point as u32, count));
             }
         };
+        // The next layer's first point (none past the last layer): one comparison a point.
+        let layer_at = |next: usize| tp.layer_starts.get(next).copied().unwrap_or(usize::MAX);
+        let mut next_layer_at = layer_at(st.next_layer);
+        // The times between which the percent is known to stay `st.last_percent` (see
+        // [`BodyWriter::percent_below`]): none known at the chunk's start.
+        let (mut percent_from, mut percent_below) = (f64::INFINITY, f64::NEG_INFINITY);
         for i in range {
             let q = &tp.points[i];
-            if p.host_metadata || p.progress {
+            if (p.host_metadata || p.progress) && i >= next_layer_at {
                 // The layer that starts at this point (or at the point before it: the first
                 // point of the path is where the approach ends).
                 while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
@@ -821,18 +832,21 @@ impl<'a> BodyWriter<'a> {
                     }
                     st.next_layer += 1;
                 }
-                if p.progress {
-                    let percent = self.percent(st.t_done);
-                    if percent != st.last_percent {
-                        mark(lines, points, 1, i - 1);
-                        let left_min = ((self.nominal - st.t_done) * self.scale / 60.0)
-                            .ceil()
-                            .max(0.0);
-                        buf.extend_from_slice(
-                            format!("M73 P{percent} R{left_min:.0}\n").as_bytes(),
-                        );
-                        st.last_percent = percent;
-                    }
+                next_layer_at = layer_at(st.next_layer);
+            }
+            // The percent is computed where it may have changed: not between the time it was
+            // last computed at and the time below which it cannot reach the next whole percent
+            // (it never falls as the time grows).
+            if p.progress && !(percent_from <= st.t_done && st.t_done < percent_below) {
+                let percent = self.percent(st.t_done);
+                (percent_from, percent_below) = (st.t_done, self.percent_below(percent));
+                if percent != st.last_percent {
+                    mark(lines, points, 1, i - 1);
+                    let left_min = ((self.nominal - st.t_done) * self.scale / 60.0)
+                        .ceil()
+                        .max(0.0);
+                    buf.extend_from_slice(format!("M73 P{percent} R{left_min:.0}\n").as_bytes());
+                    st.last_percent = percent;
                 }
             }
             let prev = &tp.points[i - 1];
@@ -875,6 +889,24 @@ impl<'a> BodyWriter<'a> {
             }
         }
         *told &= want.moves;
+    }
+}
+
+/// The whole percent of `nominal` seconds done by `t_done`, 0 … 100: never less for a later
+/// time (a division and a product, each rounded monotonically, then [`whole_percent`]).
+fn percent_done(t_done: f64, nominal: f64) -> u64 {
+    whole_percent((t_done / nominal) * 100.0)
+}
+
+/// A time below which [`percent_done`] is at most `percent`: the time of the next whole
+/// percent less a millionth of it, far more than the two roundings of [`percent_done`] (each
+/// under 2⁻⁵² of its value) can move it; never past 100. Between a time whose percent is
+/// `percent` and this one, the percent is `percent` without computing it.
+fn time_below_next_percent(percent: u64, nominal: f64) -> f64 {
+    if percent >= 100 {
+        f64::INFINITY
+    } else {
+        (percent + 1) as f64 / 100.0 * nominal * (1.0 - 1e-6)
     }
 }
 
@@ -936,6 +968,35 @@ mod tests {
         ) {
             for x in [x, f64::from(near) + tiny, f64::from(near)] {
                 proptest::prop_assert_eq!(whole_percent(x), x.floor().clamp(0.0, 100.0) as u64);
+            }
+        }
+    }
+
+    proptest::proptest! {
+        /// From a time whose percent is P up to the time below the next percent, every time's
+        /// percent is P: right at that bound, past a percent's exact time, at any nominal time.
+        #[test]
+        fn the_percent_stays_until_the_time_below_the_next(
+            nominal in proptest::prop_oneof![1e-6..1e-3f64, 1e-3..1e7f64],
+            from in 0.0..1.02f64,
+            ahead in 0.0..1.0f64,
+            whole in 0u64..101,
+        ) {
+            for t0 in [from * nominal, whole as f64 / 100.0 * nominal] {
+                let p = percent_done(t0, nominal);
+                let below = time_below_next_percent(p, nominal);
+                let last = below.next_down().min(1e300);
+                for t in [t0, t0 + (last - t0).max(0.0) * ahead, last] {
+                    if t0 <= t && t < below {
+                        proptest::prop_assert_eq!(percent_done(t, nominal), p, "{} .. {}", t0, t);
+                    }
+                }
+                // The bound is close: the next percent is reached within a thousandth of it.
+                if p < 100 {
+                    let next = (p + 1) as f64 / 100.0 * nominal * (1.0 + 1e-12);
+                    proptest::prop_assert!(percent_done(next, nominal) > p);
+                    proptest::prop_assert!(next - below < 1e-5 * nominal);
+                }
             }
         }
     }
