@@ -706,25 +706,23 @@ impl<'a> BodyWriter<'a> {
                 // second, then formats the second.
                 [first] => {
                     let first_state = state;
-                    crate::parallel::both(
+                    let (_, after) = crate::parallel::both(
                         n >= 4096,
                         || self.format(first.clone(), first_state, want, piece_a),
                         || {
-                            state = self.advance(state, first.clone());
-                            self.format(last.clone(), state, want, piece_b)
+                            let second = self.advance(first_state, first.clone());
+                            self.format(last.clone(), second, want, piece_b)
                         },
                     );
+                    state = after;
                     &pieces[..]
                 }
                 [] => {
-                    self.format(last.clone(), state, want, piece_a);
+                    state = self.format(last.clone(), state, want, piece_a);
                     &pieces[..1]
                 }
                 _ => unreachable!("at most two chunks a round"),
             };
-            if last.end < n {
-                state = self.advance(state, last.clone());
-            }
             start = last.end;
             let told: Vec<_> = used
                 .iter()
@@ -767,14 +765,14 @@ impl<'a> BodyWriter<'a> {
     }
 
     /// Formats points `range` starting from `st` into `piece` (emptied first), with what is
-    /// wanted besides the text.
+    /// wanted besides the text; the state after them (what [`BodyWriter::advance`] gives).
     fn format(
         &self,
         range: std::ops::Range<usize>,
         mut st: BodyState,
         want: Wanted,
         piece: &mut Piece,
-    ) {
+    ) -> BodyState {
         let (p, tp) = (&self.design.printer, self.tp);
         let [ox, oy] = self.origin;
         piece.clear(range.len());
@@ -813,7 +811,7 @@ impl<'a> BodyWriter<'a> {
         let (mut percent_from, mut percent_below) = (f64::INFINITY, f64::NEG_INFINITY);
         for i in range {
             let q = &tp.points[i];
-            if (p.host_metadata || p.progress) && i >= next_layer_at {
+            if i >= next_layer_at {
                 // The layer that starts at this point (or at the point before it: the first
                 // point of the path is where the approach ends).
                 while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
@@ -889,6 +887,7 @@ impl<'a> BodyWriter<'a> {
             }
         }
         *told &= want.moves;
+        st
     }
 }
 
@@ -969,6 +968,51 @@ mod tests {
             for x in [x, f64::from(near) + tiny, f64::from(near)] {
                 proptest::prop_assert_eq!(whole_percent(x), x.floor().clamp(0.0, 100.0) as u64);
             }
+        }
+    }
+
+    /// Formatting a chunk leaves the state its sums alone reach, to the bit: the next chunk
+    /// starts where it would have, with or without host metadata and progress, in either E mode,
+    /// on a path whose speeds change (the minimum layer time).
+    #[test]
+    fn formatting_a_chunk_leaves_the_state_its_sums_reach() {
+        let bits = |s: BodyState| {
+            (
+                s.t_done.to_bits(),
+                s.e_total.to_bits(),
+                s.last_speed.to_bits(),
+                s.last_percent,
+                s.next_layer,
+            )
+        };
+        let mut d = crate::load::parse_design(
+            "version = 1\n[shape]\nheight = 20.0\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 36.0 }\n[printer]\nmin_layer_time = 30.0\n",
+        )
+        .unwrap();
+        let job = crate::run(&d).unwrap();
+        let tp = &job.toolpath;
+        let n = tp.points.len();
+        for (metadata, progress, extrusion) in [
+            (true, true, ExtrusionMode::Relative),
+            (false, false, ExtrusionMode::Absolute),
+            (false, true, ExtrusionMode::Absolute),
+            (true, false, ExtrusionMode::Relative),
+        ] {
+            (d.printer.host_metadata, d.printer.progress) = (metadata, progress);
+            d.printer.extrusion = extrusion;
+            let writer = BodyWriter::new(&d, tp, (tp.print_time(), 1.3 * tp.print_time()), 9);
+            let mut state = BodyState::START;
+            for range in [1..n / 3, n / 3..n / 3 + 1, n / 3 + 1..n] {
+                let want = Wanted {
+                    index: false,
+                    moves: true,
+                };
+                let formatted = writer.format(range.clone(), state, want, &mut Piece::default());
+                let summed = writer.advance(state, range);
+                assert_eq!(bits(formatted), bits(summed));
+                state = summed;
+            }
+            assert_eq!(state.next_layer, tp.layer_starts.len());
         }
     }
 
