@@ -76,8 +76,18 @@ pub fn render(points: &[DVec3], w: u32, h: u32) -> image::RgbaImage {
             (118.0 * light + 20.0) as u8,
             (78.0 * light + 15.0) as u8,
         ];
+        // A dot near the picture (always, for a path of real numbers) converts its pixels without
+        // the checks `as` makes for NaN and the ends of the range; the same pixels.
+        let near = cx.abs() < 1e15 && cy.abs() < 1e15;
         for &(dx, dy) in &dot {
-            let (x, y) = ((cx + dx as f64) as i64, (cy + dy as f64) as i64);
+            let (x, y) = if near {
+                let (x, y) = (cx + dx as f64, cy + dy as f64);
+                // SAFETY: both are numbers well within i64 (the centre within 1e15, the offset
+                // a few pixels), whose whole parts fit.
+                unsafe { (x.to_int_unchecked::<i64>(), y.to_int_unchecked::<i64>()) }
+            } else {
+                ((cx + dx as f64) as i64, (cy + dy as f64) as i64)
+            };
             if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
                 continue;
             }

@@ -83,12 +83,22 @@ impl ChordTree {
         let built = crate::parallel::map_ranges(chords.len().div_ceil(LEAF), 4096, |range| {
             range
                 .map(|leaf| {
+                    // The box of the leaf's held chords' ends, rounded outwards once: the join of
+                    // each chord's box (the rounding to f32 and the step out are monotone).
                     let ids = leaf * LEAF..(leaf * LEAF + LEAF).min(chords.len());
-                    ids.filter(|&id| held(id))
-                        .fold((Bounds::EMPTY, 0u8), |(b, bits), id| {
+                    let (lo, hi, bits) = ids.filter(|&id| held(id)).fold(
+                        (DVec3::INFINITY, DVec3::NEG_INFINITY, 0u8),
+                        |(lo, hi, bits), id| {
                             let (a, c) = (v[chords[id].0], v[chords[id].1]);
-                            (b.join(Bounds::of(a, c)), bits | 1 << (id % LEAF))
-                        })
+                            (lo.min(a.min(c)), hi.max(a.max(c)), bits | 1 << (id % LEAF))
+                        },
+                    );
+                    let b = if bits == 0 {
+                        Bounds::EMPTY
+                    } else {
+                        Bounds::of(lo, hi)
+                    };
+                    (b, bits)
                 })
                 .collect()
         });
@@ -290,6 +300,18 @@ mod tests {
         for (id, &(a, b)) in chords.iter().enumerate() {
             let leaf = tree.levels[0][id / LEAF];
             assert_eq!(leaf.join(Bounds::of(v[a], v[b])), leaf);
+        }
+        // A leaf's box is exactly the join of its held chords' boxes (one chord in three held
+        // here, some leaves none).
+        let held = |id: usize| id % 3 == 0 && id % 40 < 20;
+        let tree = ChordTree::build(&v, &chords, &held);
+        for (leaf, &b) in tree.levels[0].iter().enumerate() {
+            let joined = (leaf * LEAF..((leaf + 1) * LEAF).min(chords.len()))
+                .filter(|&id| held(id))
+                .fold(Bounds::EMPTY, |x, id| {
+                    x.join(Bounds::of(v[chords[id].0], v[chords[id].1]))
+                });
+            assert_eq!(b, joined, "leaf {leaf}");
         }
     }
 }
