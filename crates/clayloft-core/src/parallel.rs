@@ -761,7 +761,9 @@ mod tests {
     fn populated_pages_are_mapped_and_keep_their_contents() {
         let pages = 4096;
         let mut block = Fresh::new(pages * 4096);
-        block.words(1000).iter_mut().zip(0..).for_each(|(w, k)| *w = k);
+        for (w, k) in block.words(1000).iter_mut().zip(0..) {
+            *w = k;
+        }
         let before = block.resident();
         // From inside the first page to inside the last: the whole pages between are mapped.
         populate(block.at + 100..block.at + block.bytes - 100);
@@ -789,7 +791,9 @@ mod tests {
         }
         let pages = 2048;
         let mut block = Fresh::new(pages * 4096);
-        block.words(1000).iter_mut().zip(0..).for_each(|(w, k)| *w = k);
+        for (w, k) in block.words(1000).iter_mut().zip(0..) {
+            *w = k;
+        }
         assert!(block.resident() < pages / 2);
         fault_in_while_idle(block.at..block.at + block.bytes);
         let started = Instant::now();
