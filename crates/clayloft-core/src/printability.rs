@@ -121,23 +121,45 @@ struct Layer {
 
 /// Judges the print of `toolpath` in the design's clay body.
 ///
-/// With it, the layers of `surface` (the toolpath's wall) that droop, found on a second core
-/// meanwhile.
+/// With it, the layers of `surface` (the toolpath's wall) that droop, found meanwhile: the
+/// verdict is one task, the droops of runs of [`DROOP_RUN`] layers the others, shared out as
+/// the cores get free (the verdict takes longer than the droops' half would).
 pub fn assess(
     design: &Design,
     surface: &Surface,
     toolpath: &Toolpath,
 ) -> Result<Printability, FieldError> {
     let body = crate::clay::resolve(design.clay.as_ref())?;
-    let (droops, verdict) = crate::parallel::both(
-        toolpath.points.len() >= crate::parallel::PARALLEL_POINTS,
-        || droops(design, surface),
-        || standing(design, &body, toolpath),
-    );
-    let mut droops = droops?;
+    let layers = surface.sections.len();
+    let (mut verdict, mut droops) = (None, Vec::new());
+    if toolpath.points.len() >= crate::parallel::PARALLEL_POINTS && layers > 2 {
+        let runs = (layers - 2).div_ceil(DROOP_RUN);
+        let done = crate::parallel::map_shared(
+            1 + runs,
+            || (),
+            |(), task| match task.checked_sub(1) {
+                None => (Some(standing(design, &body, toolpath)), Vec::new()),
+                Some(r) => {
+                    let from = 2 + r * DROOP_RUN;
+                    let ks = from..(from + DROOP_RUN).min(layers);
+                    (None, droops_in(design, &body, surface, ks))
+                }
+            },
+        );
+        for (v, d) in done {
+            verdict = verdict.or(v);
+            droops.extend(d);
+        }
+    } else {
+        droops = droops_in(design, &body, surface, 2..layers.max(2));
+    }
+    let verdict = verdict.unwrap_or_else(|| standing(design, &body, toolpath));
     droops.sort_by(|a, b| (b.length - b.limit).total_cmp(&(a.length - a.limit)));
     Ok(Printability { droops, ..verdict })
 }
+
+/// Layers a task of [`assess`] searches for droops.
+const DROOP_RUN: usize = 32;
 
 /// The safety factor of the wet wall of `toolpath` in clay `body` (see the module
 /// documentation), and the layer time that would make it stand.
@@ -375,11 +397,21 @@ pub fn droops(
     surface: &crate::pipeline::Surface,
 ) -> Result<Vec<Droop>, FieldError> {
     let body = crate::clay::resolve(design.clay.as_ref())?;
+    Ok(droops_in(design, &body, surface, 2..surface.sections.len()))
+}
+
+/// [`droops`] of the layers `ks` (each from 2 on), in their order.
+fn droops_in(
+    design: &Design,
+    body: &ClayBody,
+    surface: &crate::pipeline::Surface,
+    ks: std::ops::Range<usize>,
+) -> Vec<Droop> {
     let half = 0.5 * design.printer.line_width;
-    let limit = span_limit(&body, surface.layer_pitch);
+    let limit = span_limit(body, surface.layer_pitch);
     let sections = &surface.sections;
     let mut out = Vec::new();
-    for k in 2..sections.len() {
+    for k in ks {
         let (below, here) = (sections[k - 1].xy(), sections[k].xy());
         let n = here.len();
         if n < 3 || below.len() != n {
@@ -438,7 +470,7 @@ pub fn droops(
             });
         }
     }
-    Ok(out)
+    out
 }
 
 /// Whether point `p` is within `r` of the segment from `a` to `b`: exactly
@@ -574,6 +606,34 @@ mod tests {
         let p2 = judged(&two);
         // Twice the thickness, a shorter inner bead (smaller mean radius): more than twice.
         assert!(p2.factor > 2.0 * p.factor, "{} {}", p2.factor, p.factor);
+    }
+
+    /// On a path long enough for both cores, the verdict's droops are those of every layer,
+    /// found in runs of layers beside the verdict: the same as one pass over them, with the
+    /// verdict of the path itself.
+    #[test]
+    fn droops_found_in_runs_beside_the_verdict_are_every_layer_s() {
+        let d = parse_design(
+            "version = 1\n[printer]\nmax_overhang_deg = 70.0\n[shape]\nheight = 60.0\nsamples = 720\nbase_layers = 0\n[shape.lower]\ntype = \"circle\"\nradius = 40.0\n[shape.upper]\ntype = \"circle\"\nradius = 40.0\n[texture]\ncombine = \"sum\"\nphase_drift = 40.0\n[texture.x]\nwave = \"square\"\nperiod = 90\namplitude = 4.0\n[constraints]\nenforce = false\n",
+        )
+        .unwrap();
+        let job = crate::run(&d).unwrap();
+        assert!(job.toolpath.points.len() >= crate::parallel::PARALLEL_POINTS);
+        let found = droops(&d, &job.surface).unwrap();
+        // Droops in more than one run of layers.
+        assert!(
+            found.first().unwrap().layer / DROOP_RUN != found.last().unwrap().layer / DROOP_RUN
+        );
+        let p = crate::parallel::awake(|| assess(&d, &job.surface, &job.toolpath).unwrap());
+        let mut by_layer = p.droops.clone();
+        by_layer.sort_by_key(|x| x.layer);
+        assert_eq!(by_layer, found);
+        let body = crate::clay::resolve(d.clay.as_ref()).unwrap();
+        let alone = standing(&d, &body, &job.toolpath);
+        assert_eq!(
+            (p.factor.to_bits(), p.min_layer_time_to_stand),
+            (alone.factor.to_bits(), alone.min_layer_time_to_stand)
+        );
     }
 
     fn preset_density() -> f64 {
