@@ -23,6 +23,10 @@
 //!   nothing; where memory is fragmented, a first touch may wait for the kernel to compact it
 //!   (its default `defrag` setting for marked memory), as with glibc's setting.
 //!
+//! Once the design is known, [`fault_ahead_for`] has the idle helper fault in the part of that
+//! room the job will fill, so that the kernel's zeroing of fresh pages (about a tenth of a
+//! millisecond a huge page) is done beside the work, not by the thread that first writes them.
+//!
 //! The memory is returned when the process ends, a fraction of a second later.
 
 /// Largest buffer, bytes, that the heap serves from memory freed before (glibc's maximum for
@@ -78,6 +82,7 @@ static ROOM: std::sync::OnceLock<std::ops::Range<usize>> = std::sync::OnceLock::
 /// Heap a batch command fills per path point, bytes: the benchmark vase's `clayloft gcode`
 /// fills 40 MB of the room for its 216 000 points (its resident size stays 75 MB when that much
 /// is faulted in ahead, and grows past it with more).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
 const BYTES_PER_POINT: usize = 190;
 
 /// Has the idle helper fault in, ahead of use, the part of the heap's room that a job of
