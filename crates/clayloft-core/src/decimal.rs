@@ -145,9 +145,10 @@ impl Line<'_> {
     pub(crate) fn fixed_const<const D: u32, const READ: bool>(&mut self, v: f64) -> Option<f64> {
         let pow = 10u64.pow(D);
         let x = v.abs() * pow as f64;
-        // Out of range for integer formatting (never for a real printer), or not a number (x is
-        // not below anything then; it is never negative).
-        if !(x < 9.0e18) {
+        // Within range for integer formatting (false for too large, never for a real printer,
+        // and for not a number; x is never negative).
+        let in_range = x < 9.0e18;
+        if !in_range {
             self.text(format!("{v:.*}", D as usize).as_bytes());
             return None;
         }

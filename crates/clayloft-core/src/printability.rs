@@ -122,7 +122,7 @@ struct Layer {
 /// Judges the print of `toolpath` in the design's clay body.
 ///
 /// With it, the layers of `surface` (the toolpath's wall) that droop, found meanwhile: the
-/// verdict is one task, the droops of runs of [`DROOP_RUN`] layers the others, shared out as
+/// verdict is one task, the droops of runs of 32 layers (`DROOP_RUN`) the others, shared out as
 /// the cores get free (the verdict takes longer than the droops' half would).
 pub fn assess(
     design: &Design,

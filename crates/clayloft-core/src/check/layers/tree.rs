@@ -303,7 +303,7 @@ mod tests {
         }
         // A leaf's box is exactly the join of its held chords' boxes (one chord in three held
         // here, some leaves none).
-        let held = |id: usize| id % 3 == 0 && id % 40 < 20;
+        let held = |id: usize| id.is_multiple_of(3) && id % 40 < 20;
         let tree = ChordTree::build(&v, &chords, &held);
         for (leaf, &b) in tree.levels[0].iter().enumerate() {
             let joined = (leaf * LEAF..((leaf + 1) * LEAF).min(chords.len()))
