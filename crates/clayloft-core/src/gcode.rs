@@ -147,7 +147,7 @@ impl motion::Moves for JobMoves<'_> {
 
 /// Length, time and volume of a job.
 pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
-    summarize_beside(design, job, false, || ()).0
+    summarize_beside(design, job, false, || (), |_, _| ()).0
 }
 
 /// [`summarize`], with `beside` (the writer's thumbnails) run on a second core (when
@@ -157,18 +157,21 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
 /// ([`Toolpath::print_time`]). For the benchmark vase the thumbnails and the estimate took
 /// 9.3 ms with the thumbnails beside the whole planner, 6 ms so; the length and the time were
 /// then measured again beside the thumbnails (2.6 ms), 1.7 ms more on that side than on this.
-fn summarize_beside<T: Send>(
+/// Then `after(nominal time, planned time)` runs on this core too, while `beside` may still
+/// run (the body's chunk starts, in time this core used to wait for the thumbnails).
+fn summarize_beside<T: Send, U>(
     design: &Design,
     job: &PrintJob,
     use_beside: bool,
     beside: impl FnOnce() -> T + Send,
-) -> (JobSummary, f64, T) {
+    after: impl FnOnce(f64, f64) -> U,
+) -> (JobSummary, f64, T, U) {
     let p = &design.printer;
     let tp = &job.toolpath;
     let moves = JobMoves::new(design, tp);
     let plan = motion::Plan::new(moves.home, &moves, p.max_acceleration, p.junction_deviation);
     let path = moves.approach.len()..moves.approach.len() + moves.path.len();
-    let (other, (time, volume, (length, nominal_s))) =
+    let (other, (time, volume, (length, nominal_s), then)) =
         crate::parallel::both(use_beside, beside, || {
             let volume: f64 = (1..tp.points.len())
                 .map(|i| segment_volume(design, tp, i))
@@ -177,7 +180,10 @@ fn summarize_beside<T: Send>(
             let sums = plan
                 .nominal(path)
                 .unwrap_or_else(|| (tp.length(), tp.print_time()));
-            (plan.time(), volume, sums)
+            let time = plan.time();
+            // While `beside` may still run.
+            let then = after(sums.1, time);
+            (time, volume, sums, then)
         });
     let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
     let summary = JobSummary {
@@ -188,7 +194,7 @@ fn summarize_beside<T: Send>(
         volume_mm3: volume,
         e_length_mm: volume * p.flow_multiplier / feed_area,
     };
-    (summary, nominal_s, other)
+    (summary, nominal_s, other, then)
 }
 
 /// `1h 02m 03s` style duration.
@@ -390,14 +396,27 @@ fn write_program_indexed(
     let tp = &job.toolpath;
     // The thumbnails are drawn beside the motion planner's passes (the time estimate), which
     // give the print time at nominal speeds too (the body's progress is of it).
-    let (summary, nominal_s, thumbnails) = summarize_beside(design, job, true, || {
-        p.thumbnail.then(|| {
-            // Thinned to what a thumbnail draws: no copy of the whole path.
-            let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
-            let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
-            crate::thumbnail::header_blocks(&points)
-        })
-    });
+    let layers_total = tp.layer_starts.len().max(1);
+    // The body's writer, and where each of its chunks starts, found while the thumbnails are
+    // drawn.
+    let (summary, _, thumbnails, (body, starts)) = summarize_beside(
+        design,
+        job,
+        true,
+        || {
+            p.thumbnail.then(|| {
+                // Thinned to what a thumbnail draws: no copy of the whole path.
+                let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
+                let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
+                crate::thumbnail::header_blocks(&points)
+            })
+        },
+        |nominal_s, planned_s| {
+            let body = BodyWriter::new(design, tp, (nominal_s, planned_s), layers_total);
+            let starts = body.chunk_starts();
+            (body, starts)
+        },
+    );
     let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
         crate::templates::fill(t, &values)
@@ -415,7 +434,6 @@ fn write_program_indexed(
             .as_deref()
             .unwrap_or(crate::templates::default_end(p)),
     )?;
-    let layers_total = tp.layer_starts.len().max(1);
     let mut head = String::new();
     use std::fmt::Write as _;
     let _ = writeln!(
@@ -566,13 +584,7 @@ fn write_program_indexed(
     }
     out.text(&buf)?;
     buf.clear();
-    let body = BodyWriter::new(
-        design,
-        tp,
-        (nominal_s, summary.estimated_time_s),
-        layers_total,
-    );
-    body.write(out, &mut index)?;
+    body.write(out, &mut index, &starts)?;
     if !tp.points.is_empty() {
         buf.extend_from_slice(b"G0 Z");
         put_fixed(&mut buf, z_out, 3);
@@ -592,11 +604,15 @@ fn write_program_indexed(
     Ok(summary)
 }
 
-/// Points formatted per chunk: two chunks at a time go to the two threads, then to the output.
-/// About 600 kB of text each, so that the text in memory stays small whatever the path length
-/// (`clayloft gcode` never holds a whole program: it goes to the file and the self-check
+/// Points formatted per chunk: [`ROUND_CHUNKS`] chunks at a time go to the cores, then to the
+/// output. About 300 kB of text each, so that the text in memory stays small whatever the path
+/// length (`clayloft gcode` never holds a whole program: it goes to the file and the self-check
 /// piece by piece); with 128 Ki points a chunk, a whole process took 6 000 more page faults.
-const BODY_CHUNK: usize = 16 * 1024;
+const BODY_CHUNK: usize = 8 * 1024;
+
+/// Chunks formatted at a time, shared out over the cores as they get free (a core slowed by
+/// another thread on it takes fewer): two a core of this machine.
+const ROUND_CHUNKS: usize = 4;
 
 /// Where the body's running sums stand just before path point `i` is written.
 #[derive(Debug, Clone, Copy)]
@@ -673,57 +689,59 @@ impl<'a> BodyWriter<'a> {
         time_below_next_percent(percent, self.nominal)
     }
 
-    /// Writes points 1 .. n, chunk by chunk, two chunks at a time in parallel.
-    fn write(&self, out: &mut dyn ProgramOut, index: &mut Option<&mut Vec<u32>>) -> io::Result<()> {
+    /// Where each chunk of [`BODY_CHUNK`] points starts (the first at point 1): the state
+    /// before it, summed along the path in order (one pass, no text).
+    fn chunk_starts(&self) -> Vec<BodyState> {
+        let n = self.tp.points.len();
+        let mut starts = vec![BodyState::START];
+        let mut from = 1;
+        while from + BODY_CHUNK < n {
+            let state = self.advance(
+                *starts.last().expect("one or more"),
+                from..from + BODY_CHUNK,
+            );
+            starts.push(state);
+            from += BODY_CHUNK;
+        }
+        starts
+    }
+
+    /// Writes points 1 .. n, [`ROUND_CHUNKS`] chunks a round: a round's chunks are formatted
+    /// by whichever core is free (each from its start, `starts[k]` for chunk k, see
+    /// [`BodyWriter::chunk_starts`]), then handed over in order.
+    fn write(
+        &self,
+        out: &mut dyn ProgramOut,
+        index: &mut Option<&mut Vec<u32>>,
+        starts: &[BodyState],
+    ) -> io::Result<()> {
         let n = self.tp.points.len();
         if n < 2 {
             return Ok(());
         }
-        let threads = crate::parallel::cores().clamp(1, 2);
-        let mut state = BodyState::START;
         let want = Wanted {
             index: index.is_some(),
             moves: out.wants_moves(),
         };
-        // Chunks of equal size, so that the threads finish together.
-        let chunk = (n - 1).div_ceil(threads).clamp(1, BODY_CHUNK);
-        // The two chunks' pieces, reused round after round.
-        let mut pieces = [Piece::default(), Piece::default()];
-        let mut start = 1;
-        while start < n {
-            // The ranges of this round. Each starts from the state the one before it leaves:
-            // while a thread formats a chunk, the calling thread adds up that chunk's sums for
-            // the next one, then formats the last chunk itself.
-            let ranges: Vec<_> = (0..threads)
-                .map(|k| start + k * chunk)
-                .take_while(|&s| s < n)
-                .map(|s| s..(s + chunk).min(n))
+        let chunk = |k: usize| 1 + k * BODY_CHUNK..(1 + (k + 1) * BODY_CHUNK).min(n);
+        // A round's pieces, reused round after round.
+        let mut pieces: Vec<std::sync::Mutex<Piece>> = (0..ROUND_CHUNKS)
+            .map(|_| std::sync::Mutex::new(Piece::default()))
+            .collect();
+        for round in (0..starts.len()).step_by(ROUND_CHUNKS) {
+            let count = ROUND_CHUNKS.min(starts.len() - round);
+            crate::parallel::map_shared(
+                count,
+                || (),
+                |(), j| {
+                    let mut piece = pieces[j].lock().unwrap_or_else(|e| e.into_inner());
+                    self.format(chunk(round + j), starts[round + j], want, &mut piece);
+                },
+            );
+            let used: Vec<&Piece> = pieces[..count]
+                .iter_mut()
+                .map(|p| &*p.get_mut().unwrap_or_else(|e| e.into_inner()))
                 .collect();
-            let (last, others) = ranges.split_last().expect("a chunk or more");
-            let [piece_a, piece_b] = &mut pieces;
-            let used = match others {
-                // Two chunks: the first on a helper while this thread adds up its sums for the
-                // second, then formats the second.
-                [first] => {
-                    let first_state = state;
-                    let (_, after) = crate::parallel::both(
-                        n >= 4096,
-                        || self.format(first.clone(), first_state, want, piece_a),
-                        || {
-                            let second = self.advance(first_state, first.clone());
-                            self.format(last.clone(), second, want, piece_b)
-                        },
-                    );
-                    state = after;
-                    &pieces[..]
-                }
-                [] => {
-                    state = self.format(last.clone(), state, want, piece_a);
-                    &pieces[..1]
-                }
-                _ => unreachable!("at most two chunks a round"),
-            };
-            start = last.end;
             let told: Vec<_> = used
                 .iter()
                 .map(|p| crate::check::ToldPiece {
@@ -1059,14 +1077,14 @@ mod tests {
             let job = crate::run(&d).unwrap();
             let tp = &job.toolpath;
             assert!(tp.points.windows(2).any(|w| w[0].speed != w[1].speed));
-            let (summary, nominal_s, ()) = summarize_beside(&d, &job, true, || ());
+            let (summary, nominal_s, (), ()) = summarize_beside(&d, &job, true, || (), |_, _| ());
             assert_eq!(summary.path_length_mm.to_bits(), tp.length().to_bits());
             assert_eq!(nominal_s.to_bits(), tp.print_time().to_bits());
         }
     }
 
     /// The body written in rounds of chunks, on both cores, is the body formatted in one piece
-    /// on one: a path of three chunks and more (two rounds, the last short), with progress,
+    /// on one: a path of more than a round of chunks (the last short), with progress,
     /// layer announcements, absolute E carried across the chunks, and speed changes.
     #[test]
     fn chunks_write_the_body_in_one_piece() {
@@ -1077,7 +1095,8 @@ mod tests {
         d.printer.extrusion = ExtrusionMode::Absolute;
         d.printer.progress = true;
         d.printer.host_metadata = true;
-        let n = 2 * BODY_CHUNK + BODY_CHUNK / 3;
+        // More than a round of chunks, the last one short.
+        let n = (ROUND_CHUNKS + 1) * BODY_CHUNK + BODY_CHUNK / 3;
         let points: Vec<crate::toolpath::PathPoint> = (0..n)
             .map(|i| {
                 let a = i as f64 * 0.01;
@@ -1102,7 +1121,10 @@ mod tests {
         };
         let body = BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
         let (mut text, mut index) = (Vec::new(), Vec::new());
-        body.write(&mut text, &mut Some(&mut index)).unwrap();
+        crate::parallel::awake(|| {
+            body.write(&mut text, &mut Some(&mut index), &body.chunk_starts())
+        })
+        .unwrap();
         let mut whole = Piece::default();
         let want = Wanted {
             index: true,
