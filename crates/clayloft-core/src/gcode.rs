@@ -783,14 +783,14 @@ impl<'a> BodyWriter<'a> {
     }
 
     /// Formats points `range` starting from `st` into `piece` (emptied first), with what is
-    /// wanted besides the text; the state after them (what [`BodyWriter::advance`] gives).
+    /// wanted besides the text.
     fn format(
         &self,
         range: std::ops::Range<usize>,
         mut st: BodyState,
         want: Wanted,
         piece: &mut Piece,
-    ) -> BodyState {
+    ) {
         let (p, tp) = (&self.design.printer, self.tp);
         let [ox, oy] = self.origin;
         piece.clear(range.len());
@@ -905,7 +905,6 @@ impl<'a> BodyWriter<'a> {
             }
         }
         *told &= want.moves;
-        st
     }
 }
 
@@ -989,51 +988,6 @@ mod tests {
         }
     }
 
-    /// Formatting a chunk leaves the state its sums alone reach, to the bit: the next chunk
-    /// starts where it would have, with or without host metadata and progress, in either E mode,
-    /// on a path whose speeds change (the minimum layer time).
-    #[test]
-    fn formatting_a_chunk_leaves_the_state_its_sums_reach() {
-        let bits = |s: BodyState| {
-            (
-                s.t_done.to_bits(),
-                s.e_total.to_bits(),
-                s.last_speed.to_bits(),
-                s.last_percent,
-                s.next_layer,
-            )
-        };
-        let mut d = crate::load::parse_design(
-            "version = 1\n[shape]\nheight = 20.0\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 36.0 }\n[printer]\nmin_layer_time = 30.0\n",
-        )
-        .unwrap();
-        let job = crate::run(&d).unwrap();
-        let tp = &job.toolpath;
-        let n = tp.points.len();
-        for (metadata, progress, extrusion) in [
-            (true, true, ExtrusionMode::Relative),
-            (false, false, ExtrusionMode::Absolute),
-            (false, true, ExtrusionMode::Absolute),
-            (true, false, ExtrusionMode::Relative),
-        ] {
-            (d.printer.host_metadata, d.printer.progress) = (metadata, progress);
-            d.printer.extrusion = extrusion;
-            let writer = BodyWriter::new(&d, tp, (tp.print_time(), 1.3 * tp.print_time()), 9);
-            let mut state = BodyState::START;
-            for range in [1..n / 3, n / 3..n / 3 + 1, n / 3 + 1..n] {
-                let want = Wanted {
-                    index: false,
-                    moves: true,
-                };
-                let formatted = writer.format(range.clone(), state, want, &mut Piece::default());
-                let summed = writer.advance(state, range);
-                assert_eq!(bits(formatted), bits(summed));
-                state = summed;
-            }
-            assert_eq!(state.next_layer, tp.layer_starts.len());
-        }
-    }
-
     proptest::proptest! {
         /// From a time whose percent is P up to the time below the next percent, every time's
         /// percent is P: right at that bound, past a percent's exact time, at any nominal time.
@@ -1083,18 +1037,16 @@ mod tests {
         }
     }
 
-    /// The body written in rounds of chunks, on both cores, is the body formatted in one piece
-    /// on one: a path of more than a round of chunks (the last short), with progress,
-    /// layer announcements, absolute E carried across the chunks, and speed changes.
+    /// The body written in rounds of chunks, on both cores, each from the state its chunk's
+    /// sums reach, is the body formatted in one piece on one: a path of more than a round of
+    /// chunks (the last short) whose speeds change, with and without host metadata and
+    /// progress, in either E mode.
     #[test]
     fn chunks_write_the_body_in_one_piece() {
         let mut d = crate::load::parse_design(
             "version = 1\n[shape]\nheight = 20.0\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 30.0 }\n",
         )
         .unwrap();
-        d.printer.extrusion = ExtrusionMode::Absolute;
-        d.printer.progress = true;
-        d.printer.host_metadata = true;
         // More than a round of chunks, the last one short.
         let n = (ROUND_CHUNKS + 1) * BODY_CHUNK + BODY_CHUNK / 3;
         let points: Vec<crate::toolpath::PathPoint> = (0..n)
@@ -1119,22 +1071,32 @@ mod tests {
             revolutions: 1,
             findings: Vec::new(),
         };
-        let body = BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
-        let (mut text, mut index) = (Vec::new(), Vec::new());
-        crate::parallel::awake(|| {
-            body.write(&mut text, &mut Some(&mut index), &body.chunk_starts())
-        })
-        .unwrap();
-        let mut whole = Piece::default();
-        let want = Wanted {
-            index: true,
-            moves: true,
-        };
-        body.format(1..n, BodyState::START, want, &mut whole);
-        assert!(text == whole.text, "the texts differ");
-        assert_eq!(index, whole.points);
-        assert_eq!(whole.lines, index.len());
-        assert!(text.windows(4).any(|w| w == b"M73 "));
+        for (metadata, progress, extrusion) in [
+            (true, true, ExtrusionMode::Absolute),
+            (false, false, ExtrusionMode::Absolute),
+            (false, true, ExtrusionMode::Relative),
+            (true, false, ExtrusionMode::Relative),
+        ] {
+            (d.printer.host_metadata, d.printer.progress) = (metadata, progress);
+            d.printer.extrusion = extrusion;
+            let body = BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
+            let (mut text, mut index) = (Vec::new(), Vec::new());
+            crate::parallel::awake(|| {
+                body.write(&mut text, &mut Some(&mut index), &body.chunk_starts())
+            })
+            .unwrap();
+            let mut whole = Piece::default();
+            let want = Wanted {
+                index: true,
+                moves: true,
+            };
+            body.format(1..n, BodyState::START, want, &mut whole);
+            assert!(text == whole.text, "the texts differ");
+            assert_eq!(index, whole.points);
+            assert_eq!(whole.lines, index.len());
+            assert_eq!(text.windows(4).any(|w| w == b"M73 "), progress);
+            assert_eq!(text.windows(7).any(|w| w == b";LAYER:"), metadata);
+        }
     }
 
     /// The program's line index names, for every line that moves the nozzle along the path, the
