@@ -326,13 +326,7 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
     if let Ok(body) = clayloft_core::clay::resolve(d.clay.as_ref()) {
         // The printed (wet) size: the path's, which may end above the design (a wall that
         // cannot come back onto its layers), and what the kiln makes of it.
-        let (lo, hi) = job.toolpath.points.iter().map(|q| &q.pos).fold(
-            (
-                bevy::math::DVec3::splat(f64::INFINITY),
-                bevy::math::DVec3::splat(f64::NEG_INFINITY),
-            ),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
+        let (lo, hi) = s.path_bounds_mm;
         let wet = hi - lo + bevy::math::DVec3::new(d.printer.line_width, d.printer.line_width, 0.0);
         let (sxy, sz) = (
             1.0 - body.firing_shrinkage_percent / 100.0,

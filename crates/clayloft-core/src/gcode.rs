@@ -60,6 +60,9 @@ pub struct JobSummary {
     pub volume_mm3: f64,
     /// Length of "filament" the extruder advances (the sum of E), mm.
     pub e_length_mm: f64,
+    /// The box of the path's points, its lowest and its highest corner, mm (the wet size of
+    /// the vessel as printed; infinite for a path without points).
+    pub path_bounds_mm: (DVec3, DVec3),
 }
 
 /// Approach and exit moves: (approach start height, exit height).
@@ -147,54 +150,41 @@ impl motion::Moves for JobMoves<'_> {
 
 /// Length, time and volume of a job.
 pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
-    summarize_beside(design, job, false, || (), |_, _| ()).0
+    summarize_beside(design, job, false, || ()).0
 }
 
 /// [`summarize`], with `beside` (the writer's thumbnails) run on a second core (when
-/// `use_beside` and one is free) while the motion planner's look-ahead passes, the clay's
-/// volume and the path's length and time at its own speeds use this one (the planner's entry
-/// limits use both cores first); with the time at the points' own speeds, s
-/// ([`Toolpath::print_time`]). For the benchmark vase the thumbnails and the estimate took
-/// 9.3 ms with the thumbnails beside the whole planner, 6 ms so; the length and the time were
-/// then measured again beside the thumbnails (2.6 ms), 1.7 ms more on that side than on this.
-/// Then `after(nominal time, planned time)` runs on this core too, while `beside` may still
-/// run (the body's chunk starts, in time this core used to wait for the thumbnails).
-fn summarize_beside<T: Send, U>(
+/// `use_beside` and one is free) while this one sums the path in one pass ([`PathSums`]) and
+/// runs the motion planner's look-ahead passes (its entry limits use both cores first); with
+/// the path's sums. For the benchmark vase the thumbnails and the estimate took 9.3 ms with
+/// the thumbnails beside the whole planner, 6 ms so; the path's sums (its length, time,
+/// volume and box, and each body chunk's start) were five passes, one of them after
+/// `beside`, before they were one.
+fn summarize_beside<T: Send>(
     design: &Design,
     job: &PrintJob,
     use_beside: bool,
     beside: impl FnOnce() -> T + Send,
-    after: impl FnOnce(f64, f64) -> U,
-) -> (JobSummary, f64, T, U) {
+) -> (JobSummary, PathSums, T) {
     let p = &design.printer;
     let tp = &job.toolpath;
     let moves = JobMoves::new(design, tp);
     let plan = motion::Plan::new(moves.home, &moves, p.max_acceleration, p.junction_deviation);
-    let path = moves.approach.len()..moves.approach.len() + moves.path.len();
-    let (other, (time, volume, (length, nominal_s), then)) =
-        crate::parallel::both(use_beside, beside, || {
-            let volume: f64 = (1..tp.points.len())
-                .map(|i| segment_volume(design, tp, i))
-                .sum();
-            // The planner's lengths are the path's segments (a plan without acceleration keeps none).
-            let sums = plan
-                .nominal(path)
-                .unwrap_or_else(|| (tp.length(), tp.print_time()));
-            let time = plan.time();
-            // While `beside` may still run.
-            let then = after(sums.1, time);
-            (time, volume, sums, then)
-        });
+    let (other, (time, sums)) = crate::parallel::both(use_beside, beside, || {
+        let sums = PathSums::of(design, tp);
+        (plan.time(), sums)
+    });
     let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
     let summary = JobSummary {
         layers: job.surface.layers,
         points: tp.points.len(),
-        path_length_mm: length,
+        path_length_mm: sums.length,
         estimated_time_s: time,
-        volume_mm3: volume,
-        e_length_mm: volume * p.flow_multiplier / feed_area,
+        volume_mm3: sums.volume,
+        e_length_mm: sums.volume * p.flow_multiplier / feed_area,
+        path_bounds_mm: sums.bounds,
     };
-    (summary, nominal_s, other, then)
+    (summary, sums, other)
 }
 
 /// `1h 02m 03s` style duration.
@@ -243,6 +233,17 @@ impl From<GcodeWriteError> for io::Error {
 
 /// The placeholder values of a job's templates, in the printer's own coordinates.
 pub fn template_values(design: &Design, job: &PrintJob, summary: &JobSummary) -> Values {
+    let top = job
+        .toolpath
+        .points
+        .iter()
+        .map(|q| q.pos.z)
+        .fold(0.0, f64::max);
+    values_with_top(design, job, summary, top)
+}
+
+/// [`template_values`], with the path's top (its highest z, and at least 0) already known.
+fn values_with_top(design: &Design, job: &PrintJob, summary: &JobSummary, top: f64) -> Values {
     let p = &design.printer;
     let tp = &job.toolpath;
     let [ox, oy] = p.origin_offset();
@@ -250,7 +251,6 @@ pub fn template_values(design: &Design, job: &PrintJob, summary: &JobSummary) ->
         (Some(f), Some(l)) => (f.pos, l.pos),
         _ => (DVec3::ZERO, DVec3::ZERO),
     };
-    let top = tp.points.iter().map(|q| q.pos.z).fold(0.0, f64::max);
     let park_z = (top + CLEARANCE).min(p.max_z);
     // Present the part: the back of the bed comes forward on a bed slinger, the head goes
     // to the back on a gantry; the back left corner suits both (the back edge of a round bed).
@@ -394,30 +394,24 @@ fn write_program_indexed(
 ) -> Result<JobSummary, GcodeWriteError> {
     let p = &design.printer;
     let tp = &job.toolpath;
-    // The thumbnails are drawn beside the motion planner's passes (the time estimate), which
-    // give the print time at nominal speeds too (the body's progress is of it).
+    // The thumbnails are drawn beside the path's sums and the motion planner's passes.
     let layers_total = tp.layer_starts.len().max(1);
-    // The body's writer, and where each of its chunks starts, found while the thumbnails are
-    // drawn.
-    let (summary, _, thumbnails, (body, starts)) = summarize_beside(
+    let (summary, sums, thumbnails) = summarize_beside(design, job, true, || {
+        p.thumbnail.then(|| {
+            // Thinned to what a thumbnail draws: no copy of the whole path.
+            let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
+            let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
+            crate::thumbnail::header_blocks(&points)
+        })
+    });
+    let body = BodyWriter::new(
         design,
-        job,
-        true,
-        || {
-            p.thumbnail.then(|| {
-                // Thinned to what a thumbnail draws: no copy of the whole path.
-                let step = (tp.points.len() / crate::thumbnail::MAX_DRAWN).max(1);
-                let points: Vec<DVec3> = tp.points.iter().step_by(step).map(|q| q.pos).collect();
-                crate::thumbnail::header_blocks(&points)
-            })
-        },
-        |nominal_s, planned_s| {
-            let body = BodyWriter::new(design, tp, (nominal_s, planned_s), layers_total);
-            let starts = body.chunk_starts();
-            (body, starts)
-        },
+        tp,
+        (sums.nominal_s, summary.estimated_time_s),
+        layers_total,
     );
-    let values = template_values(design, job, &summary);
+    let starts = body.chunk_starts(&sums);
+    let values = values_with_top(design, job, &summary, sums.bounds.1.z.max(0.0));
     let fill = |field: &'static str, t: &str| {
         crate::templates::fill(t, &values)
             .map_err(|error| GcodeWriteError::Template { field, error })
@@ -614,6 +608,74 @@ const BODY_CHUNK: usize = 8 * 1024;
 /// another thread on it takes fewer): two a core of this machine.
 const ROUND_CHUNKS: usize = 4;
 
+/// The path's sums, in one pass in path order: its length and its time at its own speeds (the
+/// planner's moves' sums, to the bit), the clay's volume, its box, and where the
+/// body's running sums stand at each chunk's start.
+struct PathSums {
+    /// Σ |p_i − p_{i−1}|, mm.
+    length: f64,
+    /// Σ |p_i − p_{i−1}| / v_i, s ([`Toolpath::print_time`]).
+    nominal_s: f64,
+    /// Σ of each segment's volume, mm³.
+    volume: f64,
+    /// The box of the path's points: its lowest and its highest corner.
+    bounds: (DVec3, DVec3),
+    /// The state before each chunk of [`BODY_CHUNK`] points (the first at point 1), without
+    /// its progress percent, which needs the whole time: ...
+    starts: Vec<BodyState>,
+    /// ... the time done before the chunk's last point was written, whose percent it is.
+    percent_times: Vec<Option<f64>>,
+}
+
+impl PathSums {
+    /// The sums of `tp`'s points, each added in path order as the body's writer adds them.
+    fn of(design: &Design, tp: &Toolpath) -> PathSums {
+        let p = &design.printer;
+        let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
+        let e_per_mm3 = p.flow_multiplier / feed_area;
+        let absolute = p.extrusion == ExtrusionMode::Absolute;
+        let points = &tp.points;
+        let n = points.len();
+        let mut st = BodyState::START;
+        let (mut length, mut volume) = (0.0, 0.0);
+        let (mut lo, mut hi) = points
+            .first()
+            .map_or((DVec3::INFINITY, DVec3::NEG_INFINITY), |q| (q.pos, q.pos));
+        let mut starts = vec![BodyState::START];
+        let mut percent_times = vec![None];
+        let mut percent_before = None;
+        for i in 1..n {
+            let q = &points[i];
+            if (i - 1) % BODY_CHUNK == 0 && i > 1 {
+                starts.push(st);
+                percent_times.push(percent_before);
+            }
+            percent_before = Some(st.t_done);
+            let d = points[i - 1].pos.distance(q.pos);
+            length += d;
+            st.t_done += d / q.speed;
+            let v = segment_volume(design, tp, i);
+            volume += v;
+            if absolute {
+                st.e_total += v * e_per_mm3;
+            }
+            (lo, hi) = (lo.min(q.pos), hi.max(q.pos));
+            st.last_speed = q.speed;
+            while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
+                st.next_layer += 1;
+            }
+        }
+        PathSums {
+            length,
+            nominal_s: st.t_done,
+            volume,
+            bounds: (lo, hi),
+            starts,
+            percent_times,
+        }
+    }
+}
+
 /// Where the body's running sums stand just before path point `i` is written.
 #[derive(Debug, Clone, Copy)]
 struct BodyState {
@@ -689,21 +751,21 @@ impl<'a> BodyWriter<'a> {
         time_below_next_percent(percent, self.nominal)
     }
 
-    /// Where each chunk of [`BODY_CHUNK`] points starts (the first at point 1): the state
-    /// before it, summed along the path in order (one pass, no text).
-    fn chunk_starts(&self) -> Vec<BodyState> {
-        let n = self.tp.points.len();
-        let mut starts = vec![BodyState::START];
-        let mut from = 1;
-        while from + BODY_CHUNK < n {
-            let state = self.advance(
-                *starts.last().expect("one or more"),
-                from..from + BODY_CHUNK,
-            );
-            starts.push(state);
-            from += BODY_CHUNK;
-        }
-        starts
+    /// Where each chunk of [`BODY_CHUNK`] points starts (the first at point 1): the states
+    /// `sums` reached, each with the progress percent last written before it.
+    fn chunk_starts(&self, sums: &PathSums) -> Vec<BodyState> {
+        let progress = self.design.printer.progress;
+        sums.starts
+            .iter()
+            .zip(&sums.percent_times)
+            .map(|(&st, &t)| BodyState {
+                last_percent: match t {
+                    Some(t) if progress => self.percent(t),
+                    _ => st.last_percent,
+                },
+                ..st
+            })
+            .collect()
     }
 
     /// Writes points 1 .. n, [`ROUND_CHUNKS`] chunks a round: a round's chunks are formatted
@@ -756,30 +818,6 @@ impl<'a> BodyWriter<'a> {
             }
         }
         Ok(())
-    }
-
-    /// The state after points `range` (the sums only: no text).
-    fn advance(&self, mut st: BodyState, range: std::ops::Range<usize>) -> BodyState {
-        let (p, tp) = (&self.design.printer, self.tp);
-        let mut percent_before = None;
-        for i in range {
-            let q = &tp.points[i];
-            percent_before = Some(st.t_done);
-            st.t_done += tp.points[i - 1].pos.distance(q.pos) / q.speed;
-            if p.extrusion == ExtrusionMode::Absolute {
-                st.e_total += segment_volume(self.design, tp, i) * self.e_per_mm3;
-            }
-            st.last_speed = q.speed;
-            while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
-                st.next_layer += 1;
-            }
-        }
-        if p.progress
-            && let Some(t) = percent_before
-        {
-            st.last_percent = self.percent(t);
-        }
-        st
     }
 
     /// Formats points `range` starting from `st` into `piece` (emptied first), with what is
@@ -1017,13 +1055,13 @@ mod tests {
         }
     }
 
-    /// The path's length and its time at its own speeds, summed from the planner's moves, are
-    /// the toolpath's own sums to the last bit (a spiral whose speeds change: its upper layers
-    /// slowed to the minimum layer time).
+    /// The path's sums in one pass are the toolpath's own to the last bit: its length, its time
+    /// at its own speeds, the clay's volume and its box (a spiral whose speeds change: its upper
+    /// layers slowed to the minimum layer time; on a base, whose first point is the lowest).
     #[test]
-    fn the_planners_sums_are_the_paths_own() {
+    fn the_path_sums_are_the_paths_own() {
         let mut d = crate::load::parse_design(
-            "version = 1\n[shape]\nheight = 20.0\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 36.0 }\n[printer]\nmin_layer_time = 30.0\n",
+            "version = 1\n[shape]\nheight = 20.0\nbase_layers = 2\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 36.0 }\n[printer]\nmin_layer_time = 30.0\n",
         )
         .unwrap();
         for a in [500.0, 5.0] {
@@ -1031,9 +1069,29 @@ mod tests {
             let job = crate::run(&d).unwrap();
             let tp = &job.toolpath;
             assert!(tp.points.windows(2).any(|w| w[0].speed != w[1].speed));
-            let (summary, nominal_s, (), ()) = summarize_beside(&d, &job, true, || (), |_, _| ());
+            let (summary, sums, ()) = summarize_beside(&d, &job, true, || ());
             assert_eq!(summary.path_length_mm.to_bits(), tp.length().to_bits());
-            assert_eq!(nominal_s.to_bits(), tp.print_time().to_bits());
+            assert_eq!(sums.nominal_s.to_bits(), tp.print_time().to_bits());
+            let volume: f64 = (1..tp.points.len())
+                .map(|i| segment_volume(&d, tp, i))
+                .sum();
+            assert_eq!(summary.volume_mm3.to_bits(), volume.to_bits());
+            let values = template_values(&d, &job, &summary);
+            assert_eq!(
+                values,
+                values_with_top(&d, &job, &summary, sums.bounds.1.z.max(0.0))
+            );
+            let z = |q: &crate::toolpath::PathPoint| q.pos.z;
+            let top = tp.points.iter().map(z).fold(f64::MIN, f64::max);
+            let bottom = tp.points.iter().map(z).fold(f64::MAX, f64::min);
+            let x = tp.points.iter().map(|q| q.pos.x);
+            let (left, right) = (
+                x.clone().fold(f64::MAX, f64::min),
+                x.fold(f64::MIN, f64::max),
+            );
+            let (lo, hi) = summary.path_bounds_mm;
+            assert_eq!((lo.z, hi.z, lo.x, hi.x), (bottom, top, left, right));
+            assert!(lo.y < hi.y);
         }
     }
 
@@ -1082,7 +1140,11 @@ mod tests {
             let body = BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
             let (mut text, mut index) = (Vec::new(), Vec::new());
             crate::parallel::awake(|| {
-                body.write(&mut text, &mut Some(&mut index), &body.chunk_starts())
+                body.write(
+                    &mut text,
+                    &mut Some(&mut index),
+                    &body.chunk_starts(&PathSums::of(&d, &tp)),
+                )
             })
             .unwrap();
             let mut whole = Piece::default();

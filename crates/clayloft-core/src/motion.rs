@@ -166,18 +166,6 @@ impl Plan {
         }
     }
 
-    /// The length, mm, and the time at their own speeds, s, of moves `range`, summed in order
-    /// from the lengths the plan found (the same sums as measuring the moves again); `None`
-    /// for a plan without acceleration, which keeps no lengths, or a range past the moves.
-    pub fn nominal(&self, range: std::ops::Range<usize>) -> Option<(f64, f64)> {
-        let (len, speed) = (self.len.get(range.clone())?, self.speed.get(range)?);
-        Some(
-            len.iter()
-                .zip(speed)
-                .fold((0.0, 0.0), |(l, t), (&x, &v)| (l + x, t + x / v)),
-        )
-    }
-
     /// The total time, s: the look-ahead passes and the sum, in path order.
     pub fn time(self) -> f64 {
         let Plan {
@@ -357,22 +345,6 @@ fn junction_speed2(u: DVec3, w: DVec3, a: f64, deviation: f64, cap2: f64) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A plan made without acceleration keeps no lengths: its sums are none, not zero.
-    #[test]
-    fn a_plan_without_acceleration_has_no_sums() {
-        let moves = [Move {
-            to: DVec3::X,
-            speed: 10.0,
-        }];
-        assert_eq!(
-            Plan::new(DVec3::ZERO, &moves[..], 0.0, 0.01).nominal(0..1),
-            None
-        );
-        let plan = Plan::new(DVec3::ZERO, &moves[..], 100.0, 0.01);
-        assert_eq!(plan.nominal(0..1), Some((1.0, 0.1)));
-        assert_eq!(plan.nominal(0..2), None);
-    }
 
     /// The planner as it was written before it ran in parts, in one pass over an iterator: the
     /// reference the parts must match to the bit.

@@ -522,7 +522,7 @@ pub(super) fn measure_layers(
     limits: &Limits,
     report: &mut CheckReport,
 ) {
-    measure_layers_in(v, lines, limits, report, Search::NearFirst, false);
+    measure_layers_in(v, lines, limits, report, Search::NearFirst, false, None);
 }
 
 /// Whether the layers of `v` keep `limits`, shown point by point without measuring each in full
@@ -535,9 +535,10 @@ pub(super) fn layers_hold(
     lines: &[usize],
     limits: &Limits,
     report: &mut CheckReport,
+    clearance: Option<ClearanceRun>,
 ) -> bool {
     let before = report.clone();
-    let shown = measure_layers_in(v, lines, limits, report, Search::Tree, true);
+    let shown = measure_layers_in(v, lines, limits, report, Search::Tree, true, clearance);
     if !shown {
         // Not shown: the checker's own report (its grid gives the figures).
         *report = before;
@@ -570,6 +571,7 @@ fn measure_layers_in(
     report: &mut CheckReport,
     search: Search,
     first_show: bool,
+    measured: Option<ClearanceRun>,
 ) -> bool {
     let tan_max = limits.max_overhang_deg.to_radians().tan();
     let radius = limits.line_width + 2.0 * limits.max_layer_height * tan_max;
@@ -680,10 +682,20 @@ fn measure_layers_in(
         collide: Tally::default(),
     };
     report.min_layer_height = f64::INFINITY;
-    // With no layers to tally, the clearance alone, in one tight pass; else point by point.
+    // With no layers to tally, the clearance alone: as measured beside the path's copy, or in
+    // one tight pass; else point by point.
     let tallied = if below.is_empty() {
-        for (p, &line) in v.iter().zip(lines) {
-            clearance.add(p.z, line, &mut report.events);
+        match measured {
+            Some(run) => {
+                clearance.max_rise = clearance.max_rise.max(run.clearance.max_rise);
+                clearance.collide = run.clearance.collide;
+                report.events.extend(run.events);
+            }
+            None => {
+                for (p, &line) in v.iter().zip(lines) {
+                    clearance.add(p.z, line, &mut report.events);
+                }
+            }
         }
         0
     } else {
@@ -816,6 +828,7 @@ fn measure_layers_in(
 /// The holder's clearance along the path: how far the part printed rises above the point
 /// printing (the highest point so far, over it), and where that is more than the nozzle's
 /// length (the holder hits the part).
+#[derive(Debug, PartialEq)]
 struct Clearance {
     highest: f64,
     max_rise: f64,
@@ -841,6 +854,67 @@ impl Clearance {
             });
         }
         self.highest = self.highest.max(z);
+    }
+}
+
+/// The holder's clearance along one run of the path, measured as if the path began there, with
+/// the run's lowest point: two runs in path order join into the clearance of both
+/// ([`ClearanceRun::then`]). The self-check measures the two halves of the path as it copies
+/// them, on two cores, rather than in a pass of its own at the end (on one).
+#[derive(Debug, PartialEq)]
+pub(super) struct ClearanceRun {
+    clearance: Clearance,
+    lowest: f64,
+    events: Vec<PathEvent>,
+}
+
+impl ClearanceRun {
+    /// A run not yet begun, for a nozzle of `limits`.
+    pub(super) fn new(limits: &Limits) -> ClearanceRun {
+        ClearanceRun {
+            clearance: Clearance {
+                highest: f64::NEG_INFINITY,
+                max_rise: f64::NEG_INFINITY,
+                limit: limits.nozzle_length + 1e-6,
+                collide: Tally::default(),
+            },
+            lowest: f64::INFINITY,
+            events: Vec::new(),
+        }
+    }
+
+    /// The next point of the run, at height `z` on `line`.
+    #[inline]
+    pub(super) fn add(&mut self, z: f64, line: usize) {
+        self.clearance.add(z, line, &mut self.events);
+        self.lowest = self.lowest.min(z);
+    }
+
+    /// This run followed by `later`: as if every point had been added to one, or `None` where
+    /// that cannot be told from the two (a point of `later` lower than this run's highest by
+    /// more than the nozzle's length: its rise was measured from `later`'s own points only).
+    ///
+    /// Otherwise every rise in `later` is the larger of its own and this run's highest over the
+    /// point, and the second is within the limit: the collisions are `later`'s own, and the
+    /// largest rise this run makes in it is its highest over `later`'s lowest.
+    pub(super) fn then(self, later: ClearanceRun) -> Option<ClearanceRun> {
+        let (a, b) = (self.clearance, later.clearance);
+        let over_later = a.highest - later.lowest;
+        if over_later > a.limit {
+            return None;
+        }
+        let mut events = self.events;
+        events.extend(later.events);
+        Some(ClearanceRun {
+            clearance: Clearance {
+                highest: a.highest.max(b.highest),
+                max_rise: a.max_rise.max(b.max_rise).max(over_later),
+                limit: a.limit,
+                collide: a.collide.then(b.collide),
+            },
+            lowest: self.lowest.min(later.lowest),
+            events,
+        })
     }
 }
 
@@ -1575,8 +1649,8 @@ mod tests {
             let lines: Vec<usize> = (0..v.len()).collect();
             let limits = Limits::from(&Printer::default());
             let (mut near, mut whole) = (CheckReport::default(), CheckReport::default());
-            measure_layers_in(&v, &lines, &limits, &mut near, Search::NearFirst, false);
-            measure_layers_in(&v, &lines, &limits, &mut whole, Search::WholeBox, false);
+            measure_layers_in(&v, &lines, &limits, &mut near, Search::NearFirst, false, None);
+            measure_layers_in(&v, &lines, &limits, &mut whole, Search::WholeBox, false, None);
             prop_assert_eq!(&near, &whole);
         }
     }
@@ -1644,9 +1718,9 @@ mod tests {
                 let lines: Vec<usize> = (0..v.len()).collect();
                 let (mut grid, mut every) = (CheckReport::default(), CheckReport::default());
                 let mut tree = CheckReport::default();
-                measure_layers_in(v, &lines, &limits, &mut grid, Search::NearFirst, false);
-                measure_layers_in(v, &lines, &limits, &mut every, Search::EveryChord, false);
-                measure_layers_in(v, &lines, &limits, &mut tree, Search::Tree, false);
+                measure_layers_in(v, &lines, &limits, &mut grid, Search::NearFirst, false, None);
+                measure_layers_in(v, &lines, &limits, &mut every, Search::EveryChord, false, None);
+                measure_layers_in(v, &lines, &limits, &mut tree, Search::Tree, false, None);
                 prop_assert_eq!(&grid, &every);
                 prop_assert_eq!(&tree, &every);
             }
@@ -1664,15 +1738,60 @@ mod tests {
             for v in &paths {
                 let lines: Vec<usize> = (0..v.len()).collect();
                 let (mut full, mut quick) = (CheckReport::default(), CheckReport::default());
-                measure_layers_in(v, &lines, &limits, &mut full, Search::NearFirst, false);
-                let shown = layers_hold(v, &lines, &limits, &mut quick);
+                measure_layers_in(v, &lines, &limits, &mut full, Search::NearFirst, false, None);
+                let measured = clearance_in_halves(v, &lines, &limits, v.len() / 2);
+                let shown = layers_hold(v, &lines, &limits, &mut quick, measured);
                 let broken = full.violations.iter().any(|x| x.what != COLLISION);
                 prop_assert!(!(shown && broken), "shown, but {}", full);
                 if shown {
                     prop_assert_eq!(&quick.violations, &full.violations);
+                    prop_assert_eq!(&quick.events, &full.events);
                     prop_assert_eq!(quick.max_rise_above_tip, full.max_rise_above_tip);
                 } else {
                     prop_assert_eq!(&quick, &full);
+                }
+            }
+        }
+    }
+
+    /// The clearance of `v` measured in two runs split at `at`, joined (see
+    /// [`ClearanceRun::then`]).
+    fn clearance_in_halves(
+        v: &[DVec3],
+        lines: &[usize],
+        limits: &Limits,
+        at: usize,
+    ) -> Option<ClearanceRun> {
+        let run = |range: std::ops::Range<usize>| {
+            let mut run = ClearanceRun::new(limits);
+            range.for_each(|j| run.add(v[j].z, lines[j]));
+            run
+        };
+        run(0..at).then(run(at..v.len()))
+    }
+
+    proptest! {
+        /// Two runs of a path joined are the clearance measured in one pass, wherever the path
+        /// is split, or none where they cannot tell: heights that rise and fall by up to twice
+        /// the nozzle's length (collisions in either run, and across the split).
+        #[test]
+        fn two_runs_of_clearance_join_into_the_whole(
+            z in proptest::collection::vec(0.0..60.0f64, 0..40),
+            split in 0.0..1.0f64,
+        ) {
+            let limits = Limits::from(&Printer::default());
+            let v: Vec<DVec3> = z.iter().map(|&z| DVec3::new(0.0, 0.0, z)).collect();
+            let lines: Vec<usize> = (0..v.len()).map(|j| 10 + j).collect();
+            let at = (split * v.len() as f64) as usize;
+            let mut whole = ClearanceRun::new(&limits);
+            v.iter().zip(&lines).for_each(|(p, &line)| whole.add(p.z, line));
+            match clearance_in_halves(&v, &lines, &limits, at) {
+                Some(joined) => prop_assert_eq!(joined, whole),
+                None => {
+                    // Only where a point after the split lies more than the nozzle below one
+                    // before it.
+                    let highest = z[..at].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    prop_assert!(z[at..].iter().any(|&z| highest - z > limits.nozzle_length));
                 }
             }
         }
@@ -1777,7 +1896,7 @@ mod tests {
         let lines: Vec<usize> = (0..per_rev * 14).collect();
         let mut plain = CheckReport::default();
         assert!(
-            layers_hold(&helix(0..0), &lines, &limits, &mut plain),
+            layers_hold(&helix(0..0), &lines, &limits, &mut plain, None),
             "{plain}"
         );
         // Long bumps, and bumps thin under one point only (wherever a run of points starts).
@@ -1791,7 +1910,10 @@ mod tests {
             measure_layers(&v, &lines, &limits, &mut full);
             let thin = full.violations.iter().find(|x| x.what == "layer too thin");
             assert!(thin.is_some_and(|x| x.count <= 2 * len), "{start}: {full}");
-            assert!(!layers_hold(&v, &lines, &limits, &mut quick), "{start}");
+            assert!(
+                !layers_hold(&v, &lines, &limits, &mut quick, None),
+                "{start}"
+            );
             assert_eq!(quick, full);
         }
     }
@@ -1855,7 +1977,7 @@ mod tests {
         assert!(report.ok(), "{report}");
         assert!(report.max_overhang_deg < 32.0, "{report}");
         let mut quick = CheckReport::default();
-        assert!(layers_hold(&v, &lines, &limits, &mut quick));
+        assert!(layers_hold(&v, &lines, &limits, &mut quick, None));
     }
 
     #[test]
@@ -1877,7 +1999,7 @@ mod tests {
             let within = lean_deg < limits.max_overhang_deg;
             assert_eq!(full.ok(), within, "{lean_deg}°: {full}");
             assert_eq!(
-                layers_hold(&v, &lines, &limits, &mut quick),
+                layers_hold(&v, &lines, &limits, &mut quick, None),
                 within,
                 "{lean_deg}°"
             );
@@ -1927,7 +2049,7 @@ mod tests {
             measure_layers(&v, &lines, &limits, &mut full);
             assert_eq!(full.ok(), within, "{lean_deg}° {step} mm: {full}");
             assert_eq!(
-                layers_hold(&v, &lines, &limits, &mut quick),
+                layers_hold(&v, &lines, &limits, &mut quick, None),
                 within,
                 "{lean_deg}° {step} mm"
             );
@@ -1946,7 +2068,7 @@ mod tests {
             let mut full = CheckReport::default();
             measure_layers(&v, &lines, &limits, &mut full);
             assert_eq!(
-                layers_hold(&v, &lines, &limits, &mut report),
+                layers_hold(&v, &lines, &limits, &mut report, None),
                 holds,
                 "{flare} {wobble} {full}"
             );
@@ -2056,6 +2178,7 @@ mod tests {
             &mut report,
             Search::NearFirst,
             false,
+            None,
         );
         assert!(
             report.max_overhang_deg > 50.0,

@@ -150,11 +150,11 @@ fn check_moves(
     let last_ext = moves.iter().rposition(|m| m.de > 0.0);
     let extruding = first_ext.zip(last_ext);
     let tally = |range| MoveTally::of(moves, range, start, limits, extruding);
-    let (path, tallied) = extruding_path(moves, start, shift, extruding, tally);
+    let (path, tallied) = extruding_path(moves, start, shift, extruding, limits, tally);
     tallied.into_report(limits, &mut report);
-    if let Some((vertices, lines)) = path {
+    if let Some(((vertices, lines), clearance)) = path {
         if show {
-            let shown = layers::layers_hold(&vertices, &lines, limits, &mut report);
+            let shown = layers::layers_hold(&vertices, &lines, limits, &mut report, clearance);
             return Ok((report, shown));
         }
         layers::measure_layers(&vertices, &lines, limits, &mut report);
@@ -165,20 +165,27 @@ fn check_moves(
 /// The points of an extruding path in the bed frame, and each one's G-code line.
 type PathPoints = (Vec<DVec3>, Vec<usize>);
 
+/// [`PathPoints`], with the holder's clearance along them where their two halves tell it
+/// ([`layers::ClearanceRun::then`]).
+type MeasuredPath = (PathPoints, Option<layers::ClearanceRun>);
+
 /// The extruding path `moves[a..=b]` (`extruding`: a and b) for the layer search: the point it
-/// starts from and each move's end, in the bed frame (`shift` added), with each point's line;
-/// and the moves' tally (`tally` of a range of moves: see [`MoveTally`]). In two halves, one on
-/// a second core and one on this one, each copying its half of the path and tallying its half
-/// of the moves: the copy was mostly the new buffers' page faults (3.2 ms on one core for the
-/// benchmark vase's 7 MB, before batch commands took huge pages), the tally a pass over every
-/// move.
+/// starts from and each move's end, in the bed frame (`shift` added), with each point's line
+/// and the holder's clearance along them (for a nozzle of `limits`); and the moves' tally
+/// (`tally` of a range of moves: see [`MoveTally`]). In two halves, one on a second core and
+/// one on this one, each copying its half of the path, measuring its clearance and tallying its
+/// half of the moves: the copy was mostly the new buffers' page faults (3.2 ms on one core for
+/// the benchmark vase's 7 MB, before batch commands took huge pages), the tally a pass over
+/// every move, the clearance a pass of its own at the end of the self-check (1.5 ms on one core
+/// in a slow hour).
 fn extruding_path(
     moves: &[Move],
     start: DVec3,
     shift: DVec3,
     extruding: Option<(usize, usize)>,
+    limits: &Limits,
     tally: impl Fn(std::ops::Range<usize>) -> MoveTally + Sync,
-) -> (Option<PathPoints>, MoveTally) {
+) -> (Option<MeasuredPath>, MoveTally) {
     let halves = |count: usize| [0..count / 2, count / 2..count];
     let two_cores = moves.len() >= crate::parallel::PARALLEL_POINTS;
     let Some((a, b)) = extruding else {
@@ -193,6 +200,7 @@ fn extruding_path(
     let fill = |from: usize,
                 points: &mut [std::mem::MaybeUninit<DVec3>],
                 at: &mut [std::mem::MaybeUninit<usize>]| {
+        let mut clearance = layers::ClearanceRun::new(limits);
         for (k, (p, l)) in (from..).zip(points.iter_mut().zip(at.iter_mut())) {
             let (to, line) = match k {
                 0 if a == 0 => (start, moves[a].line),
@@ -201,29 +209,25 @@ fn extruding_path(
             };
             p.write(to);
             l.write(line);
+            clearance.add(to.z, line);
         }
+        clearance
     };
     let half = count / 2;
     let (p0, p1) = vertices.spare_capacity_mut()[..count].split_at_mut(half);
     let (l0, l1) = lines.spare_capacity_mut()[..count].split_at_mut(half);
     let [first, second] = halves(moves.len());
-    let (t0, t1) = crate::parallel::both(
+    let ((c0, t0), (c1, t1)) = crate::parallel::both(
         two_cores,
-        || {
-            fill(0, p0, l0);
-            tally(first)
-        },
-        || {
-            fill(half, p1, l1);
-            tally(second)
-        },
+        || (fill(0, p0, l0), tally(first)),
+        || (fill(half, p1, l1), tally(second)),
     );
     // SAFETY: the two halves wrote every one of the first `count` slots of both buffers.
     unsafe {
         vertices.set_len(count);
         lines.set_len(count);
     }
-    (Some((vertices, lines)), t0.then(t1))
+    (Some(((vertices, lines), c0.then(c1))), t0.then(t1))
 }
 
 /// What single moves show, tallied over a range of them: the bounds of the extruding moves,
