@@ -500,6 +500,17 @@ pub fn both<A: Send, B>(
     (out_a.expect("the helper ran a"), b)
 }
 
+/// [`both`] where a helper is free: `a` on it while `b` runs here; `None`, with neither run,
+/// where none is (for work split in a way that costs more than the whole on one core).
+pub fn try_both<A: Send, B>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B) -> Option<(A, B)> {
+    let helper = Helper::claim()?;
+    let mut out_a = None;
+    let handed = helper.hand(Box::new(|| out_a = Some(a())));
+    let b = b();
+    handed.wait();
+    Some((out_a.expect("the helper ran a"), b))
+}
+
 /// `f(&mut state, k)` for every task k in `0..count`, the results in the order of k. The tasks
 /// are shared out as they go: this thread and every free helper take the next task not yet
 /// taken whenever they finish one, each with a `state` of its own from `init` (scratch space
@@ -681,6 +692,47 @@ mod tests {
             );
             assert_eq!(got, (0..100).collect::<Vec<_>>());
         }
+    }
+
+    /// Two parts tried together run both, the first on a helper, or neither (no helper free:
+    /// other tests may hold it); seen both ways, the second from inside a part that holds every
+    /// helper there is.
+    #[test]
+    fn parts_tried_together_run_on_two_threads_or_not_at_all() {
+        let try_once = || {
+            let ran = AtomicUsize::new(0);
+            let out = try_both(
+                || {
+                    ran.fetch_add(1, Ordering::Relaxed);
+                    std::thread::current().id()
+                },
+                || {
+                    ran.fetch_add(1, Ordering::Relaxed);
+                    7
+                },
+            );
+            match out {
+                Some((there, b)) => {
+                    assert_ne!(there, std::thread::current().id());
+                    assert_eq!((b, ran.load(Ordering::Relaxed)), (7, 2));
+                    true
+                }
+                None => {
+                    assert_eq!(ran.load(Ordering::Relaxed), 0);
+                    false
+                }
+            }
+        };
+        let started = Instant::now();
+        while !awake(try_once) {
+            assert!(started.elapsed() < Duration::from_secs(30), "never a helper free");
+        }
+        let helpers = pool().helpers.len();
+        let held: Vec<_> = (0..helpers).filter_map(|_| Helper::claim()).collect();
+        if held.len() == helpers {
+            assert!(!try_once(), "no helper was free");
+        }
+        held.iter().for_each(|h| h.claimed.store(false, Ordering::Release));
     }
 
     /// Work started beside the caller gives its result on joining, whether a helper took it

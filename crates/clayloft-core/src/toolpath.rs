@@ -260,14 +260,37 @@ pub fn base_fills_then(
 /// innermost back out to the outer bead). Each bead is thus laid on the same bead one revolution
 /// below, a full layer thick everywhere but at its seam, where it starts `(1 − 1/W)·Δ` above the
 /// end of its last turn (the validator keeps that printable). The levelled rim levels every bead.
-// Index loops: sample i addresses several parallel arrays (sections, fractions, z below).
-#[allow(clippy::needless_range_loop)]
 pub fn build_toolpath_on(
     design: &Design,
     surface: &Surface,
     fills: &[crate::base_fill::BaseFill],
     inner: &[Vec<Section>],
 ) -> Result<Toolpath, FieldError> {
+    build_toolpath_split(design, surface, fills, inner, true).map(|(path, _)| path)
+}
+
+/// How the helix was made (see [`Helix::from_guess`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum HelixHalves {
+    /// On one core.
+    One,
+    /// In two halves, the later from a guessed state that held.
+    Kept,
+    /// In two halves, the later made again on this core (its guessed state did not hold).
+    MadeAgain,
+}
+
+/// [`build_toolpath_on`], its helix in two halves on two cores where `split` and a helper is
+/// free; with how it was made.
+// Index loops: sample i addresses several parallel arrays (sections, fractions, z below).
+#[allow(clippy::needless_range_loop)]
+fn build_toolpath_split(
+    design: &Design,
+    surface: &Surface,
+    fills: &[crate::base_fill::BaseFill],
+    inner: &[Vec<Section>],
+    split: bool,
+) -> Result<(Toolpath, HelixHalves), FieldError> {
     let p = &design.printer;
     let sections = &surface.sections;
     let layers = surface.layers;
@@ -336,7 +359,7 @@ pub fn build_toolpath_on(
     let first = base.max(1);
     let flat_z = first as f64 * h;
     // The z each bead reached at each sample one revolution ago (index 0: where its turn ended).
-    let mut z_below: Vec<Vec<f64>> = vec![vec![flat_z; n]; walls];
+    let z_below: Vec<Vec<f64>> = vec![vec![flat_z; n]; walls];
     // A one-bead wall continues from where it is; more beads step across at point 0.
     let from = if walls > 1 { 0 } else { 1 };
     if base == 0 {
@@ -362,71 +385,60 @@ pub fn build_toolpath_on(
         r.map(|turn| arc_fractions(&beads[turn % walls][first + turn / walls]))
             .collect()
     });
-    let mut z_now = vec![0.0; n];
-    // The helix's pages (the job's largest buffer) are faulted in on the second core ahead of
-    // this loop, which is one core's work: 6.8 → 4.4 ms on the benchmark vase.
-    let faulted = crate::parallel::fault_in_spare(&b.points);
-    for k in first..layers {
-        let start = b.points.len();
-        layer_starts.push(start);
-        for (t, bead) in beads.iter().enumerate() {
-            let (lo, hi) = (&bead[k], &bead[k + 1]);
-            let frac = &fractions[(k - first) * walls + t];
-            let below = &mut z_below[t];
-            z_now[0] = below[0];
-            // The turn as the sections place it (from the flat layer on the first revolution),
-            // then lifted where it must be (see [`turn_lift`]).
-            let lo_z = |j: usize| if k == first { flat_z } else { lo.points[j].z };
-            let scheduled = |i: usize, j: usize| {
-                lo_z(j) + (hi.points[j].z - lo_z(j)) * (t as f64 + frac[i]) * share
-            };
-            // The first turn leaves the flat layer; every other goes on from where the path is.
-            let path_z = b.points.last().map_or(flat_z, |q| q.pos.z);
-            let lift = turn_lift(
-                [scheduled(0, 0), scheduled(n, 0)],
-                path_z,
-                below[0],
-                a,
-                k == first && t == 0,
-                walls > 1,
-            );
-            for i in from..=n {
-                let f = (t as f64 + frac[i]) * share;
-                // i = n closes the turn at point 0 (compared: a division per point costs more).
-                let j = if i == n { 0 } else { i };
-                let z = scheduled(i, j) + lift[0] + (lift[1] - lift[0]) * frac[i];
-                // XY from the sections at the turn's fraction; on the first revolution at its
-                // height's progress from the flat layer, so that the lean never exceeds that of
-                // the sections where it starts above it.
-                let g = if k == first {
-                    let rise = hi.points[j].z - flat_z;
-                    if rise > 0.0 {
-                        ((z - flat_z) / rise).clamp(0.0, 1.0)
-                    } else {
-                        f
-                    }
-                } else {
-                    f
-                };
-                let xy = lo.points[j].truncate().lerp(hi.points[j].truncate(), g);
-                // Consecutive revolutions measure arc length along slightly different sections,
-                // so the thickness can stray from the layer pitch by a few micrometres: keep it
-                // inside the printer's range exactly. Point 0 (the step onto this bead) lies on
-                // where the bead's last turn ended.
-                let z = z.clamp(below[j] + a, below[j] + p.max_layer_height.max(a));
-                let thickness = z - below[j];
-                b.push(DVec3::new(xy.x, xy.y, z), thickness);
-                if i > 0 {
-                    z_now[j] = z;
-                }
-            }
-            std::mem::swap(below, &mut z_now);
+    let helix = Helix {
+        beads: &beads,
+        fractions: &fractions,
+        first,
+        flat_z,
+        from,
+        share,
+        a,
+        thickest: p.max_layer_height.max(a),
+        min_layer_time: p.min_layer_time,
+    };
+    let mut state = HelixState {
+        z_below,
+        last: b.points.last().map(|q| q.pos),
+    };
+    // The later half on a second core, from a state guessed a few revolutions before it (the
+    // halves then take about as long); kept only where the earlier half, made here, reaches
+    // that state to the bit.
+    let (helix_made, split) = (split, (first + layers + HELIX_WARM_UP) / 2);
+    let halves = (helix_made
+        && wall_points >= crate::parallel::PARALLEL_POINTS as u128
+        && split > first + HELIX_WARM_UP
+        && split < layers)
+        .then(|| {
+            let speed = b.speed;
+            crate::parallel::try_both(
+                || helix.from_guess(split, layers, speed),
+                || helix.run(first..split, &mut state, &mut b, &mut layer_starts),
+            )
+        })
+        .flatten();
+    let helix_made = match halves {
+        Some((later, ())) if later.from == state => {
+            let offset = b.points.len();
+            b.points.extend_from_slice(&later.points[later.skip..]);
+            layer_starts.extend(later.starts.iter().map(|s| s - later.skip + offset));
+            state = later.to;
+            HelixHalves::Kept
         }
-        apply_min_layer_time(&mut b.points, start, p.min_layer_time);
-        revolutions += 1;
-    }
-
-    faulted.join();
+        Some(_) => {
+            helix.run(split..layers, &mut state, &mut b, &mut layer_starts);
+            HelixHalves::MadeAgain
+        }
+        None => {
+            // The helix's pages (the job's largest buffer) are faulted in on the second core
+            // ahead of this loop, which is one core's work: 6.8 → 4.4 ms on the benchmark vase.
+            let faulted = crate::parallel::fault_in_spare(&b.points);
+            helix.run(first..layers, &mut state, &mut b, &mut layer_starts);
+            faulted.join();
+            HelixHalves::One
+        }
+    };
+    revolutions += layers - first.min(layers);
+    let z_below = state.z_below;
 
     // Where the first revolution's rise put the wall ahead of the sections and it never caught
     // up (min_layer_height = the layer height), the vessel ends that much taller: say so.
@@ -484,13 +496,206 @@ pub fn build_toolpath_on(
         p.flow_ramp_end,
     );
     layer_starts.dedup();
-    Ok(Toolpath {
-        points,
-        base_points,
-        revolutions,
-        layer_starts,
-        findings,
-    })
+    Ok((
+        Toolpath {
+            points,
+            base_points,
+            revolutions,
+            layer_starts,
+            findings,
+        },
+        helix_made,
+    ))
+}
+
+/// Revolutions the second core makes before its half of the helix, from a guessed state
+/// ([`Helix::from_guess`]): one settles a state unless a lift or a clamp carries over from
+/// revolution to revolution (then the halves disagree, and the later is made again on one core).
+const HELIX_WARM_UP: usize = 2;
+
+/// What the helix carries from one revolution to the next: where each bead's last turn ended
+/// at each sample, and the path's last point (which the next point's merge, the next turn's
+/// lift and the next revolution's minimum time read).
+#[derive(Debug, Clone)]
+struct HelixState {
+    z_below: Vec<Vec<f64>>,
+    last: Option<DVec3>,
+}
+
+impl PartialEq for HelixState {
+    /// The same to the bit (a state made again must give the same path).
+    fn eq(&self, other: &Self) -> bool {
+        let bits =
+            |v: &Vec<Vec<f64>>| -> Vec<u64> { v.iter().flatten().map(|z| z.to_bits()).collect() };
+        let point = |p: Option<DVec3>| p.map(|p| p.to_array().map(f64::to_bits));
+        bits(&self.z_below) == bits(&other.z_below) && point(self.last) == point(other.last)
+    }
+}
+
+/// A later part of the helix made from a guessed state: its points (the warm-up revolutions'
+/// first, `skip` of them), the start of each of its revolutions in `points`, the state it
+/// guessed the part to start from and the state it ends in.
+struct LaterHelix {
+    points: Vec<PathPoint>,
+    skip: usize,
+    starts: Vec<usize>,
+    from: HelixState,
+    to: HelixState,
+}
+
+/// The helix of a wall (step 3 of [`build_toolpath_on`]): revolution k goes from section k to
+/// k + 1, turn t of it along bead t, at the turn's arc `fractions`.
+struct Helix<'a> {
+    beads: &'a [&'a [Section]],
+    fractions: &'a [Vec<f64>],
+    first: usize,
+    flat_z: f64,
+    /// The first sample of each turn (1 on a one-bead wall, which goes on from where it is).
+    from: usize,
+    share: f64,
+    /// The thinnest and thickest layer.
+    a: f64,
+    thickest: f64,
+    min_layer_time: f64,
+}
+
+impl Helix<'_> {
+    /// Revolutions `ks` from `state`, onto `b`, each revolution's start into `starts`.
+    fn run(
+        &self,
+        ks: std::ops::Range<usize>,
+        state: &mut HelixState,
+        b: &mut PathBuilder,
+        starts: &mut Vec<usize>,
+    ) {
+        let n = self.beads[0][0].points.len();
+        let mut z_now = vec![0.0; n];
+        for k in ks {
+            let start = b.points.len();
+            starts.push(start);
+            for t in 0..self.beads.len() {
+                self.turn(k, t, &mut state.z_below[t], &mut z_now, b);
+            }
+            apply_min_layer_time(&mut b.points, start, self.min_layer_time);
+        }
+        state.last = b.points.last().map(|q| q.pos);
+    }
+
+    /// Revolutions `split .. end` on their own: from a state guessed [`HELIX_WARM_UP`]
+    /// revolutions before `split` (each bead at its section's heights, the path at the last
+    /// bead's point 0), at feed rate `speed`.
+    fn from_guess(&self, split: usize, end: usize, speed: f64) -> LaterHelix {
+        let k0 = split - HELIX_WARM_UP;
+        let guess = HelixState {
+            z_below: self
+                .beads
+                .iter()
+                .map(|bead| bead[k0].points.iter().map(|q| q.z).collect())
+                .collect(),
+            last: self.beads.last().map(|bead| bead[k0].points[0]),
+        };
+        let mut b = PathBuilder {
+            points: Vec::with_capacity(
+                (end - k0 + 1) * self.beads.len() * (self.beads[0][0].points.len() + 1),
+            ),
+            speed,
+        };
+        // The guessed last point stands before the warm-up (the merge and the minimum time
+        // read it).
+        b.points.extend(guess.last.map(|pos| PathPoint {
+            pos,
+            thickness: 0.0,
+            flow: 1.0,
+            speed,
+        }));
+        let (mut state, mut starts) = (guess, Vec::new());
+        self.run(k0..split, &mut state, &mut b, &mut starts);
+        let (from, skip) = (state.clone(), b.points.len());
+        starts.clear();
+        self.run(split..end, &mut state, &mut b, &mut starts);
+        LaterHelix {
+            points: b.points,
+            skip,
+            starts,
+            from,
+            to: state,
+        }
+    }
+
+    /// Turn t of revolution k onto `b`, from where bead t's last turn ended (`below`), which it
+    /// then holds where this one ends (`z_now` is scratch of the same length).
+    fn turn(
+        &self,
+        k: usize,
+        t: usize,
+        below: &mut Vec<f64>,
+        z_now: &mut Vec<f64>,
+        b: &mut PathBuilder,
+    ) {
+        let (first, flat_z, share, a) = (self.first, self.flat_z, self.share, self.a);
+        let walls = self.beads.len();
+        let bead = self.beads[t];
+        let n = bead[0].points.len();
+        let (lo, hi) = (&bead[k], &bead[k + 1]);
+        let frac = &self.fractions[(k - first) * walls + t][..=n];
+        z_now[0] = below[0];
+        // The turn as the sections place it (from the flat layer on the first revolution),
+        // then lifted where it must be (see [`turn_lift`]). Sliced to the samples, so that
+        // the loop below indexes without bounds checks.
+        let (lo_pts, hi_pts) = (&lo.points[..n], &hi.points[..n]);
+        let lo_z = |j: usize| if k == first { flat_z } else { lo_pts[j].z };
+        let scheduled =
+            |i: usize, j: usize| lo_z(j) + (hi_pts[j].z - lo_z(j)) * (t as f64 + frac[i]) * share;
+        // The first turn leaves the flat layer; every other goes on from where the path is.
+        let path_z = b.points.last().map_or(flat_z, |q| q.pos.z);
+        let lift = turn_lift(
+            [scheduled(0, 0), scheduled(n, 0)],
+            path_z,
+            below[0],
+            a,
+            k == first && t == 0,
+            walls > 1,
+        );
+        let (under, now) = (&below[..n], &mut z_now[..n]);
+        for i in self.from..=n {
+            let f = (t as f64 + frac[i]) * share;
+            // i = n closes the turn at point 0 (compared: a division per point costs more).
+            let j = if i == n { 0 } else { i };
+            let z = scheduled(i, j) + lift[0] + (lift[1] - lift[0]) * frac[i];
+            // XY from the sections at the turn's fraction; on the first revolution at its
+            // height's progress from the flat layer, so that the lean never exceeds that of
+            // the sections where it starts above it.
+            let g = if k == first {
+                let rise = hi_pts[j].z - flat_z;
+                if rise > 0.0 {
+                    ((z - flat_z) / rise).clamp(0.0, 1.0)
+                } else {
+                    f
+                }
+            } else {
+                f
+            };
+            let xy = lo_pts[j].truncate().lerp(hi_pts[j].truncate(), g);
+            // Consecutive revolutions measure arc length along slightly different sections,
+            // so the thickness can stray from the layer pitch by a few micrometres: keep it
+            // inside the printer's range exactly (`clamp`, without its check that the range
+            // is one: thinnest ≤ thickest). Point 0 (the step onto this bead) lies on where
+            // the bead's last turn ended.
+            let (low, high) = (under[j] + a, under[j] + self.thickest);
+            let z = if z < low {
+                low
+            } else if z > high {
+                high
+            } else {
+                z
+            };
+            b.push(DVec3::new(xy.x, xy.y, z), z - under[j]);
+            if i > 0 {
+                now[j] = z;
+            }
+        }
+        std::mem::swap(below, z_now);
+    }
 }
 
 /// How far a turn of a bead is lifted above where the sections place it, at its start and at
@@ -960,6 +1165,39 @@ points = [[0.0, 0.0], [90.0, 6.1], [180.0, 0.0], [270.0, 1.8]]
         let q = &job.toolpath.points[200];
         let chord = 2.0 * 30.0 * (std::f64::consts::PI / 90.0).sin();
         assert!((q.speed - 90.0 * chord / 30.0).abs() < 0.02, "{}", q.speed);
+    }
+
+    /// The helix made in two halves on two cores is the helix made on one, point for point:
+    /// where the later half's guessed state holds (layers thinner than the thickest, so that
+    /// nothing is clamped from revolution to revolution; one bead or two, on a base) and where
+    /// it does not and that half is made again (layers as thick as the printer lays them on a
+    /// flaring star, whose arc lengths differ from revolution to revolution).
+    #[test]
+    fn the_helix_in_halves_is_the_helix_on_one_core() {
+        let vase = "[printer]\nlayer_height = 0.5\nmax_layer_height = 1.0\n[shape]\nheight = 60.0\nsamples = 200\n\
+                    [shape.lower]\ntype = \"circle\"\nradius = 40.0\n[shape.upper]\ntype = \"circle\"\nradius = 52.0\n";
+        let star = "[printer]\nmin_layer_time = 10.0\n[shape]\nheight = 60.0\nsamples = 360\nwalls = 2\n\
+                    [shape.lower]\ntype = \"star\"\npoints = 6\nouter_radius = 45.0\ninner_radius = 34.0\n\
+                    [shape.upper]\ntype = \"star\"\npoints = 6\nouter_radius = 70.0\ninner_radius = 56.0\n";
+        for (text, walls, base, made) in [
+            (vase, 1, 0, HelixHalves::Kept),
+            (vase, 2, 3, HelixHalves::Kept),
+            (star, 2, 3, HelixHalves::MadeAgain),
+        ] {
+            let mut d = parse_design(&format!("version = 1\n{text}")).unwrap();
+            (d.shape.walls, d.shape.base_layers) = (walls, base);
+            let job = run(&d).unwrap();
+            let fills = base_fills(&d, &job.surface).unwrap();
+            let beads = inner_beads(&d, &job.surface).unwrap();
+            let (halves, how) = crate::parallel::awake(|| {
+                build_toolpath_split(&d, &job.surface, &fills, &beads, true).unwrap()
+            });
+            let (one, alone) =
+                build_toolpath_split(&d, &job.surface, &fills, &beads, false).unwrap();
+            assert_eq!((how, alone), (made, HelixHalves::One), "{walls} beads");
+            assert!(halves == one, "{walls} beads, {made:?}: the paths differ");
+            assert!(halves == *job.toolpath);
+        }
     }
 
     #[test]
