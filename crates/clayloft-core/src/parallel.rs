@@ -725,14 +725,18 @@ mod tests {
         };
         let started = Instant::now();
         while !awake(try_once) {
-            assert!(started.elapsed() < Duration::from_secs(30), "never a helper free");
+            assert!(
+                started.elapsed() < Duration::from_secs(30),
+                "never a helper free"
+            );
         }
         let helpers = pool().helpers.len();
         let held: Vec<_> = (0..helpers).filter_map(|_| Helper::claim()).collect();
         if held.len() == helpers {
             assert!(!try_once(), "no helper was free");
         }
-        held.iter().for_each(|h| h.claimed.store(false, Ordering::Release));
+        held.iter()
+            .for_each(|h| h.claimed.store(false, Ordering::Release));
     }
 
     /// Work started beside the caller gives its result on joining, whether a helper took it

@@ -269,7 +269,7 @@ pub fn build_toolpath_on(
     build_toolpath_split(design, surface, fills, inner, true).map(|(path, _)| path)
 }
 
-/// How the helix was made (see [`Helix::from_guess`]).
+/// How the helix was made (see [`Helix::later_from_guess`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum HelixHalves {
     /// On one core.
@@ -282,8 +282,6 @@ enum HelixHalves {
 
 /// [`build_toolpath_on`], its helix in two halves on two cores where `split` and a helper is
 /// free; with how it was made.
-// Index loops: sample i addresses several parallel arrays (sections, fractions, z below).
-#[allow(clippy::needless_range_loop)]
 fn build_toolpath_split(
     design: &Design,
     surface: &Surface,
@@ -411,7 +409,7 @@ fn build_toolpath_split(
         .then(|| {
             let speed = b.speed;
             crate::parallel::try_both(
-                || helix.from_guess(split, layers, speed),
+                || helix.later_from_guess(split, layers, speed),
                 || helix.run(first..split, &mut state, &mut b, &mut layer_starts),
             )
         })
@@ -509,7 +507,7 @@ fn build_toolpath_split(
 }
 
 /// Revolutions the second core makes before its half of the helix, from a guessed state
-/// ([`Helix::from_guess`]): one settles a state unless a lift or a clamp carries over from
+/// ([`Helix::later_from_guess`]): one settles a state unless a lift or a clamp carries over from
 /// revolution to revolution (then the halves disagree, and the later is made again on one core).
 const HELIX_WARM_UP: usize = 2;
 
@@ -584,7 +582,7 @@ impl Helix<'_> {
     /// Revolutions `split .. end` on their own: from a state guessed [`HELIX_WARM_UP`]
     /// revolutions before `split` (each bead at its section's heights, the path at the last
     /// bead's point 0), at feed rate `speed`.
-    fn from_guess(&self, split: usize, end: usize, speed: f64) -> LaterHelix {
+    fn later_from_guess(&self, split: usize, end: usize, speed: f64) -> LaterHelix {
         let k0 = split - HELIX_WARM_UP;
         let guess = HelixState {
             z_below: self
@@ -624,6 +622,8 @@ impl Helix<'_> {
 
     /// Turn t of revolution k onto `b`, from where bead t's last turn ended (`below`), which it
     /// then holds where this one ends (`z_now` is scratch of the same length).
+    // Index loop: sample i addresses several parallel arrays (sections, fractions, z below).
+    #[allow(clippy::needless_range_loop)]
     fn turn(
         &self,
         k: usize,
