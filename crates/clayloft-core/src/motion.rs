@@ -112,7 +112,10 @@ pub struct Plan {
     len: Vec<f64>,
     speed: Vec<f64>,
     /// `entry2[i]`: squared speed entering move i; `entry2[n]` = 0 (the job ends at rest).
+    /// Each part's own backward pass is made (see [`backward_within`]).
     entry2: Vec<f64>,
+    /// The parts the moves were planned in, in order.
+    parts: Vec<std::ops::Range<usize>>,
 }
 
 impl Plan {
@@ -134,14 +137,21 @@ impl Plan {
                 len: Vec::new(),
                 speed: Vec::new(),
                 entry2: Vec::new(),
+                parts: Vec::new(),
             };
         }
         let n = moves.len();
-        let (mut len, mut speed) = (vec![0.0; n], vec![0.0; n]);
-        let mut entry2 = vec![0.0; n + 1];
+        // Written part by part, never cleared first (clearing them was a memset of 5 MB on one
+        // core for the benchmark vase).
+        let (mut len, mut speed) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut entry2 = Vec::with_capacity(n + 1);
         let parts = crate::parallel::ranges(n, serial_below);
         {
-            let (mut len, mut speed, mut entry2) = (&mut len[..], &mut speed[..], &mut entry2[..n]);
+            let (mut len, mut speed, mut entry2) = (
+                &mut len.spare_capacity_mut()[..n],
+                &mut speed.spare_capacity_mut()[..n],
+                &mut entry2.spare_capacity_mut()[..n],
+            );
             let mut jobs = Vec::with_capacity(parts.len());
             for range in &parts {
                 let (l, rest_l) = std::mem::take(&mut len).split_at_mut(range.len());
@@ -158,11 +168,36 @@ impl Plan {
             }
             crate::parallel::run_parts(jobs);
         }
+        // SAFETY: the parts cover 0 .. n, and `entry_limits` writes each move's three values.
+        unsafe {
+            len.set_len(n);
+            speed.set_len(n);
+            entry2.set_len(n);
+        }
+        // The job ends at rest.
+        entry2.push(0.0);
+        // The backward pass within each part, on every core; [`Plan::time`] carries it across
+        // the parts' ends.
+        {
+            let two_a = 2.0 * a;
+            let mut jobs = Vec::with_capacity(parts.len());
+            let (mut rest, last) = (&mut entry2[..], parts.len().saturating_sub(1));
+            for (p, range) in parts.iter().enumerate() {
+                let (e, after) = std::mem::take(&mut rest).split_at_mut(range.len());
+                rest = after;
+                let l = &len[range.clone()];
+                // The last part ends at rest; every other is carried across later.
+                let end = (p == last).then_some(0.0);
+                jobs.push(move || backward_within(e, l, end, two_a));
+            }
+            crate::parallel::run_parts(jobs);
+        }
         Plan {
             a,
             len,
             speed,
             entry2,
+            parts,
         }
     }
 
@@ -173,19 +208,16 @@ impl Plan {
             len,
             speed,
             mut entry2,
+            parts,
         } = self;
         if a.is_nan() || a <= 0.0 {
             return 0.0;
         }
         let n = len.len();
         let two_a = 2.0 * a;
-        // Backward pass: every move can still slow down to the next entry speed.
-        for i in (0..n).rev() {
-            let reach = entry2[i + 1] + two_a * len[i];
-            if entry2[i] > reach {
-                entry2[i] = reach;
-            }
-        }
+        // Backward pass: every move can still slow down to the next entry speed. Each part made
+        // its own; carried across the parts' ends here.
+        carry_backward(&mut entry2, &len, &parts, two_a);
         // Forward pass: acceleration from the previous entry limits this one. Once it has limited
         // move i's exit (the next entry), both ends of move i are final: its time is added then.
         let mut total = 0.0;
@@ -205,11 +237,54 @@ impl Plan {
     }
 }
 
+/// The backward pass over one part of the moves (`entry2` and `len` of its moves): each entry
+/// lowered to what decelerating at `two_a`/2 from the next entry allows, the part's last from
+/// `end` (the entry after the part), or not at all where that is not known yet.
+///
+/// Carried across the part's end later, from the final entry after it, the pass gives what one
+/// pass over all moves gives, to the bit: with E the one pass's entries and L these
+/// (L ≥ E, as L starts from no limit), min(L_i, E_{i+1} + c_i) = min(e_i, E_{i+1} + c_i) = E_i
+/// (rounding is monotone, so E_{i+1} + c_i ≤ L_{i+1} + c_i); and once an entry is left as it
+/// is, so is every one before it.
+fn backward_within(entry2: &mut [f64], len: &[f64], end: Option<f64>, two_a: f64) {
+    let Some(last) = entry2.len().checked_sub(1) else {
+        return;
+    };
+    if let Some(end) = end {
+        let reach = end + two_a * len[last];
+        if entry2[last] > reach {
+            entry2[last] = reach;
+        }
+    }
+    for i in (0..last).rev() {
+        let reach = entry2[i + 1] + two_a * len[i];
+        if entry2[i] > reach {
+            entry2[i] = reach;
+        }
+    }
+}
+
+/// The backward pass that each of `parts` made on its own ([`backward_within`], every part but
+/// the last without the entry after it) carried across the parts' ends, from the last: each
+/// part's entries lowered from its end back only as far as they change.
+fn carry_backward(entry2: &mut [f64], len: &[f64], parts: &[std::ops::Range<usize>], two_a: f64) {
+    for range in parts.iter().rev().skip(1) {
+        for i in range.clone().rev() {
+            let reach = entry2[i + 1] + two_a * len[i];
+            if entry2[i] > reach {
+                entry2[i] = reach;
+            } else {
+                break;
+            }
+        }
+    }
+}
+
 /// One part of the planner's per-move values.
 struct Legs<'a> {
-    len: &'a mut [f64],
-    speed: &'a mut [f64],
-    entry2: &'a mut [f64],
+    len: &'a mut [std::mem::MaybeUninit<f64>],
+    speed: &'a mut [std::mem::MaybeUninit<f64>],
+    entry2: &'a mut [std::mem::MaybeUninit<f64>],
 }
 
 /// Each move's length, speed and the squared speed it may enter at (its own speed, the speed
@@ -242,9 +317,9 @@ fn entry_limits(
         let m = moves.get(i);
         let d = m.to - prev;
         let l = d.length();
-        legs.entry2[k] = corners.entry2(d, l, m.speed * m.speed);
-        legs.len[k] = l;
-        legs.speed[k] = m.speed;
+        legs.entry2[k].write(corners.entry2(d, l, m.speed * m.speed));
+        legs.len[k].write(l);
+        legs.speed[k].write(m.speed);
         prev = m.to;
     }
 }
@@ -426,6 +501,42 @@ mod tests {
             let parts = plan_time_in(start, &moves[..], a, 0.013, serial_below);
             let reference = plan_time_reference(start, moves.iter().copied(), a, 0.013);
             proptest::prop_assert_eq!(parts.to_bits(), reference.to_bits(), "{} vs {}", parts, reference);
+        }
+    }
+
+    proptest::proptest! {
+        /// The backward pass made part by part and carried across the parts' ends is the one
+        /// pass over every move, to the bit, however many parts: entries that brake over many
+        /// moves, across several parts' ends (a stop a few moves on, after long fast runs).
+        #[test]
+        fn the_backward_pass_in_parts_is_the_one_pass(
+            moves in proptest::collection::vec((0.0f64..3.0, 0u8..8), 1..300),
+            cuts in proptest::collection::vec(0.0f64..1.0, 0..8),
+            two_a in 1.0f64..400.0,
+        ) {
+            let len: Vec<f64> = moves.iter().map(|m| m.0).collect();
+            let mut entry2: Vec<f64> = moves.iter().map(|m| if m.1 == 0 { 0.0 } else { 2500.0 }).collect();
+            entry2.push(0.0);
+            let n = len.len();
+            let mut one = entry2.clone();
+            for i in (0..n).rev() {
+                let reach = one[i + 1] + two_a * len[i];
+                if one[i] > reach {
+                    one[i] = reach;
+                }
+            }
+            let mut ends: Vec<usize> = cuts.iter().map(|c| (c * n as f64) as usize).collect();
+            ends.push(n);
+            ends.sort_unstable();
+            ends.dedup();
+            let parts: Vec<_> = std::iter::once(0).chain(ends.iter().copied()).zip(ends.iter().copied()).filter(|(s, e)| e > s).map(|(s, e)| s..e).collect();
+            let last = parts.len() - 1;
+            for (p, r) in parts.iter().enumerate() {
+                backward_within(&mut entry2[r.clone()], &len[r.clone()], (p == last).then_some(0.0), two_a);
+            }
+            carry_backward(&mut entry2, &len, &parts, two_a);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            proptest::prop_assert_eq!(bits(&entry2), bits(&one));
         }
     }
 
