@@ -350,6 +350,7 @@ impl Corners {
 
     /// The squared speed the next move (`d`, `l` = |d| long, squared speed `v2`) may enter at:
     /// its own speed, the speed before it and the corner allow. It then becomes the last move.
+    #[inline]
     fn entry2(&mut self, d: DVec3, l: f64, v2: f64) -> f64 {
         let limit2 = if l == 0.0 {
             // A move that goes nowhere passes the speed on unchanged.
