@@ -231,19 +231,9 @@ impl From<GcodeWriteError> for io::Error {
     }
 }
 
-/// The placeholder values of a job's templates, in the printer's own coordinates.
+/// The placeholder values of a job's templates, in the printer's own coordinates (the top of
+/// the path from the summary's box).
 pub fn template_values(design: &Design, job: &PrintJob, summary: &JobSummary) -> Values {
-    let top = job
-        .toolpath
-        .points
-        .iter()
-        .map(|q| q.pos.z)
-        .fold(0.0, f64::max);
-    values_with_top(design, job, summary, top)
-}
-
-/// [`template_values`], with the path's top (its highest z, and at least 0) already known.
-fn values_with_top(design: &Design, job: &PrintJob, summary: &JobSummary, top: f64) -> Values {
     let p = &design.printer;
     let tp = &job.toolpath;
     let [ox, oy] = p.origin_offset();
@@ -251,6 +241,7 @@ fn values_with_top(design: &Design, job: &PrintJob, summary: &JobSummary, top: f
         (Some(f), Some(l)) => (f.pos, l.pos),
         _ => (DVec3::ZERO, DVec3::ZERO),
     };
+    let top = summary.path_bounds_mm.1.z.max(0.0);
     let park_z = (top + CLEARANCE).min(p.max_z);
     // Present the part: the back of the bed comes forward on a bed slinger, the head goes
     // to the back on a gantry; the back left corner suits both (the back edge of a round bed).
@@ -411,7 +402,7 @@ fn write_program_indexed(
         layers_total,
     );
     let starts = body.chunk_starts(&sums);
-    let values = values_with_top(design, job, &summary, sums.bounds.1.z.max(0.0));
+    let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
         crate::templates::fill(t, &values)
             .map_err(|error| GcodeWriteError::Template { field, error })
@@ -1076,11 +1067,6 @@ mod tests {
                 .map(|i| segment_volume(&d, tp, i))
                 .sum();
             assert_eq!(summary.volume_mm3.to_bits(), volume.to_bits());
-            let values = template_values(&d, &job, &summary);
-            assert_eq!(
-                values,
-                values_with_top(&d, &job, &summary, sums.bounds.1.z.max(0.0))
-            );
             let z = |q: &crate::toolpath::PathPoint| q.pos.z;
             let top = tp.points.iter().map(z).fold(f64::MIN, f64::max);
             let bottom = tp.points.iter().map(z).fold(f64::MAX, f64::min);
