@@ -280,14 +280,14 @@ enum HelixHalves {
     MadeAgain,
 }
 
-/// [`build_toolpath_on`], its helix in two halves on two cores where `split` and a helper is
-/// free; with how it was made.
+/// [`build_toolpath_on`], its helix in two halves on two cores where `in_halves` (and it is
+/// long enough, and a helper is free); with how it was made.
 fn build_toolpath_split(
     design: &Design,
     surface: &Surface,
     fills: &[crate::base_fill::BaseFill],
     inner: &[Vec<Section>],
-    split: bool,
+    in_halves: bool,
 ) -> Result<(Toolpath, HelixHalves), FieldError> {
     let p = &design.printer;
     let sections = &surface.sections;
@@ -401,16 +401,16 @@ fn build_toolpath_split(
     // The later half on a second core, from a state guessed a few revolutions before it (the
     // halves then take about as long); kept only where the earlier half, made here, reaches
     // that state to the bit.
-    let (helix_made, split) = (split, (first + layers + HELIX_WARM_UP) / 2);
-    let halves = (helix_made
+    let mid = (first + layers + HELIX_WARM_UP) / 2;
+    let halves = (in_halves
         && wall_points >= crate::parallel::PARALLEL_POINTS as u128
-        && split > first + HELIX_WARM_UP
-        && split < layers)
+        && mid > first + HELIX_WARM_UP
+        && mid < layers)
         .then(|| {
             let speed = b.speed;
             crate::parallel::try_both(
-                || helix.later_from_guess(split, layers, speed),
-                || helix.run(first..split, &mut state, &mut b, &mut layer_starts),
+                || helix.later_from_guess(mid, layers, speed),
+                || helix.run(first..mid, &mut state, &mut b, &mut layer_starts),
             )
         })
         .flatten();
@@ -423,7 +423,7 @@ fn build_toolpath_split(
             HelixHalves::Kept
         }
         Some(_) => {
-            helix.run(split..layers, &mut state, &mut b, &mut layer_starts);
+            helix.run(mid..layers, &mut state, &mut b, &mut layer_starts);
             HelixHalves::MadeAgain
         }
         None => {

@@ -553,7 +553,8 @@ pub(super) fn measure_layers(
 /// where a witness shows it (see [`LayerSearch::proves`]): true when shown for every point, and
 /// then `report` holds the path's length and the holder's clearance only, not the layers'
 /// figures; false when not (a limit broken, or the search's budget spent), and then `report` is
-/// [`measure_layers`]'s.
+/// [`measure_layers`]'s. The clearance is `clearance` where it was measured already (as the
+/// path was copied), else measured here.
 pub(super) fn layers_hold(
     v: &[DVec3],
     lines: &[usize],
@@ -587,7 +588,8 @@ enum Search {
     Tree,
 }
 
-/// [`measure_layers`], searched as `search` says; with `first_show`, [`layers_hold`].
+/// [`measure_layers`], searched as `search` says; with `first_show`, [`layers_hold`]. Where no
+/// point's layers are tallied, the holder's clearance is `measured`'s, if given.
 fn measure_layers_in(
     v: &[DVec3],
     lines: &[usize],
