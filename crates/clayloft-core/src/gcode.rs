@@ -84,6 +84,16 @@ fn segment_volume(design: &Design, tp: &Toolpath, i: usize) -> f64 {
     design.printer.line_width * b.thickness.max(0.0) * len * b.flow
 }
 
+/// Cross-section of the feed (the "filament" E counts), mm²: π·d²/4.
+fn feed_area(p: &crate::design::Printer) -> f64 {
+    std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0
+}
+
+/// E advanced per mm³ of clay extruded: the flow multiplier over the feed's cross-section.
+fn e_per_mm3(p: &crate::design::Printer) -> f64 {
+    p.flow_multiplier / feed_area(p)
+}
+
 /// Where the nozzle is when the start G-code has homed, in the bed frame: a delta at the top
 /// of its column over the centre, other printers at the origin corner.
 fn home_position(p: &crate::design::Printer) -> DVec3 {
@@ -174,14 +184,13 @@ fn summarize_beside<T: Send>(
         let sums = PathSums::of(design, tp);
         (plan.time(), sums)
     });
-    let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
     let summary = JobSummary {
         layers: job.surface.layers,
         points: tp.points.len(),
         path_length_mm: sums.length,
         estimated_time_s: time,
         volume_mm3: sums.volume,
-        e_length_mm: sums.volume * p.flow_multiplier / feed_area,
+        e_length_mm: sums.volume * p.flow_multiplier / feed_area(p),
         path_bounds_mm: sums.bounds,
     };
     (summary, sums, other)
@@ -622,8 +631,7 @@ impl PathSums {
     /// The sums of `tp`'s points, each added in path order as the body's writer adds them.
     fn of(design: &Design, tp: &Toolpath) -> PathSums {
         let p = &design.printer;
-        let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
-        let e_per_mm3 = p.flow_multiplier / feed_area;
+        let e_per_mm3 = e_per_mm3(p);
         let absolute = p.extrusion == ExtrusionMode::Absolute;
         let points = &tp.points;
         let n = points.len();
@@ -719,13 +727,12 @@ impl<'a> BodyWriter<'a> {
         layers_total: usize,
     ) -> Self {
         let p = &design.printer;
-        let feed_area = std::f64::consts::PI * p.feed_diameter * p.feed_diameter / 4.0;
         let nominal = nominal_s.max(1e-9);
         BodyWriter {
             design,
             tp,
             origin: p.origin_offset(),
-            e_per_mm3: p.flow_multiplier / feed_area,
+            e_per_mm3: e_per_mm3(p),
             nominal,
             scale: planned_s / nominal,
             layers_total,

@@ -523,10 +523,11 @@ struct HelixState {
 impl PartialEq for HelixState {
     /// The same to the bit (a state made again must give the same path).
     fn eq(&self, other: &Self) -> bool {
-        let bits =
-            |v: &Vec<Vec<f64>>| -> Vec<u64> { v.iter().flatten().map(|z| z.to_bits()).collect() };
+        fn bits(v: &[Vec<f64>]) -> impl Iterator<Item = u64> + '_ {
+            v.iter().flatten().map(|z| z.to_bits())
+        }
         let point = |p: Option<DVec3>| p.map(|p| p.to_array().map(f64::to_bits));
-        bits(&self.z_below) == bits(&other.z_below) && point(self.last) == point(other.last)
+        point(self.last) == point(other.last) && bits(&self.z_below).eq(bits(&other.z_below))
     }
 }
 
