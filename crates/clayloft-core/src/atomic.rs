@@ -141,7 +141,10 @@ pub fn prepare<T>(
             .map_err(|e| err(e.to_string()))?;
     }
     let filled = {
-        let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
+        // Small writes (a header's lines, an STL's triangles) are gathered; a write of at least
+        // the buffer's size (a G-code body's chunk of 300 kB) goes to the file as it is, not
+        // copied into the buffer first (8 MB copied for the benchmark vase with a 1 MB buffer).
+        let mut w = BufWriter::with_capacity(WRITE_BUFFER, tmp.as_file());
         let filled = fill(&mut w).map_err(|e| err(e.to_string()))?;
         w.flush().map_err(|e| err(e.to_string()))?;
         filled
@@ -157,6 +160,9 @@ pub fn prepare<T>(
         filled,
     ))
 }
+
+/// The buffer of an atomic write, bytes.
+const WRITE_BUFFER: usize = 64 << 10;
 
 /// Starts the file's data for the disk without waiting for it. A rename that replaces a file
 /// on ext4 writes the new file's data out first (`auto_da_alloc`, which keeps a crash from

@@ -823,6 +823,22 @@ impl<'a> BodyWriter<'a> {
     fn format(
         &self,
         range: std::ops::Range<usize>,
+        st: BodyState,
+        want: Wanted,
+        piece: &mut Piece,
+    ) {
+        // Whether the moves are read back is decided once a chunk: each way has its own loop.
+        if want.moves {
+            self.format_reading::<true>(range, st, want, piece);
+        } else {
+            self.format_reading::<false>(range, st, want, piece);
+        }
+    }
+
+    /// [`BodyWriter::format`] with `want.moves` as `MOVES`, a constant in the loop.
+    fn format_reading<const MOVES: bool>(
+        &self,
+        range: std::ops::Range<usize>,
         mut st: BodyState,
         want: Wanted,
         piece: &mut Piece,
@@ -830,7 +846,7 @@ impl<'a> BodyWriter<'a> {
         let (p, tp) = (&self.design.printer, self.tp);
         let [ox, oy] = self.origin;
         piece.clear(range.len());
-        if want.moves {
+        if MOVES {
             piece.moves.reserve(range.len());
         }
         let Piece {
@@ -906,17 +922,17 @@ impl<'a> BodyWriter<'a> {
             let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
             let (x, y, z, e) = Line::append(buf, |line| {
                 line.text(b"G1 X");
-                let x = number::<3>(line, q.pos.x - ox, want.moves);
+                let x = number::<3>(line, q.pos.x - ox, MOVES);
                 line.text(b" Y");
-                let y = number::<3>(line, q.pos.y - oy, want.moves);
+                let y = number::<3>(line, q.pos.y - oy, MOVES);
                 line.text(b" Z");
-                let z = number::<3>(line, q.pos.z, want.moves);
+                let z = number::<3>(line, q.pos.z, MOVES);
                 line.text(b" E");
                 let e = match p.extrusion {
-                    ExtrusionMode::Relative => number::<5>(line, e, want.moves),
+                    ExtrusionMode::Relative => number::<5>(line, e, MOVES),
                     ExtrusionMode::Absolute => {
                         st.e_total += e;
-                        number::<5>(line, st.e_total, want.moves)
+                        number::<5>(line, st.e_total, MOVES)
                     }
                 };
                 if q.speed != st.last_speed {
@@ -928,7 +944,7 @@ impl<'a> BodyWriter<'a> {
                 (x, y, z, e)
             });
             mark(lines, points, 1, i);
-            if want.moves {
+            if MOVES {
                 // What the checker's reader makes of the line: X Y Z E as written.
                 match (x, y, z, e) {
                     (Some(x), Some(y), Some(z), Some(e)) => moves.push(crate::check::Move {
@@ -940,7 +956,7 @@ impl<'a> BodyWriter<'a> {
                 }
             }
         }
-        *told &= want.moves;
+        *told &= MOVES;
     }
 }
 

@@ -273,12 +273,15 @@ fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> Option<FoldF
     let mut q: Vec<DVec2> = (0..n).map(|i| p[i] + normals[i] * given[i]).collect();
     let mut shifts = given.clone();
     let mut folded = vec![false; n];
-    // A stretch found clean stays clean: only its own points move.
+    // A stretch found clean stays clean: only its own points move. After the first round, a
+    // stretch is searched only where its points moved (the points marked the round before).
     let mut active = vec![true; stretches.len()];
+    let mut marked: Vec<Vec<usize>> = vec![Vec::new(); stretches.len()];
     let (mut ps, mut qs) = (Vec::new(), Vec::new());
     for round in 0..FOLD_ROUNDS {
         let mut found = false;
-        for (&(first, len), active) in stretches.iter().zip(&mut active) {
+        for ((&(first, len), active), marked) in stretches.iter().zip(&mut active).zip(&mut marked)
+        {
             if !*active {
                 continue;
             }
@@ -286,7 +289,12 @@ fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> Option<FoldF
             qs.clear();
             ps.extend((first..first + len).map(|i| p[i % n]));
             qs.extend((first..first + len).map(|i| q[i % n]));
-            *active = mark_folds(&ps, &qs, reach, |k| folded[(first + k) % n] = true);
+            let moved = (round > 0).then(|| touching(len, marked));
+            marked.clear();
+            *active = mark_folds(&ps, &qs, reach, moved.as_deref(), |k| {
+                folded[(first + k) % n] = true;
+                marked.push(k);
+            });
             found |= *active;
         }
         if !found {
@@ -307,39 +315,100 @@ fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> Option<FoldF
     (!lowered.is_empty()).then_some(FoldFade { shifts, lowered })
 }
 
+/// Which of a stretch's `len` points touch a point of `marked`: the point itself, or the one
+/// after it (the segment from it ends there).
+fn touching(len: usize, marked: &[usize]) -> Vec<bool> {
+    let mut touches = vec![false; len];
+    for &k in marked {
+        touches[k] = true;
+        if k > 0 {
+            touches[k - 1] = true;
+        }
+    }
+    touches
+}
+
 /// Marks (by `mark(k)`) the ends of the chords `qₖ → qₖ₊ₘ` (m ≤ `reach`) of a stretch that
 /// point against `pₖ → pₖ₊ₘ`, and of the segments that cross one `m ≥ 2` further on; whether
 /// any.
+///
+/// With `moved` (see [`touching`]: the points that touch a point moved since the stretch was
+/// last searched), only the pairs with an end that touches one are tested. The others are as
+/// they were: none folded then (a pair that folds marks its ends, which then move), and none
+/// folds now.
 fn mark_folds(
     p: &[glam::DVec2],
     q: &[glam::DVec2],
     reach: usize,
+    moved: Option<&[bool]>,
     mut mark: impl FnMut(usize),
 ) -> bool {
     let len = q.len();
-    let mut any = false;
-    for a in 0..len {
-        for b in a + 1..=(a + reach).min(len - 1) {
-            if (q[b] - q[a]).dot(p[b] - p[a]) < 0.0 {
-                any = true;
+    let mut folds = 0;
+    // Tests pair (a, b), marking its ends where it folds (a macro: a closure here is not
+    // inlined, and the search costs a third more).
+    macro_rules! test {
+        ($a:expr, $b:expr) => {{
+            let (a, b) = ($a, $b);
+            let pair = pair_folds(p, q, a, b);
+            if pair != 0 {
+                folds |= pair;
                 mark(a);
                 mark(b);
+                if pair & CROSSES != 0 {
+                    mark(a + 1);
+                    mark(b + 1);
+                }
             }
-            // Segment a (a → a + 1) and segment b (b → b + 1), not neighbours.
-            if b >= a + 2 && b + 1 < len {
-                let (a0, a1, b0, b1) = (q[a], q[a + 1], q[b], q[b + 1]);
-                let apart =
-                    a0.max(a1).cmplt(b0.min(b1)).any() || b0.max(b1).cmplt(a0.min(a1)).any();
-                if !apart && crate::geometry::segments_intersect(a0, a1, b0, b1) {
-                    any = true;
-                    for k in [a, a + 1, b, b + 1] {
-                        mark(k);
-                    }
+        }};
+    }
+    match moved {
+        None => {
+            for a in 0..len {
+                for b in a + 1..=(a + reach).min(len - 1) {
+                    test!(a, b);
+                }
+            }
+        }
+        Some(moved) => {
+            // Each pair with a moved end once: from its first end, else from its second.
+            for a in (0..len).filter(|&a| moved[a]) {
+                for b in a + 1..=(a + reach).min(len - 1) {
+                    test!(a, b);
+                }
+            }
+            for b in (0..len).filter(|&b| moved[b]) {
+                for a in (b.saturating_sub(reach)..b).filter(|&a| !moved[a]) {
+                    test!(a, b);
                 }
             }
         }
     }
-    any
+    folds != 0
+}
+
+/// [`pair_folds`]: the chord from a to b runs backwards (its ends are marked).
+const RUNS_BACK: u8 = 1;
+/// [`pair_folds`]: segment a crosses segment b (the ends of both are marked).
+const CROSSES: u8 = 2;
+
+/// How points a < b of a stretch fold ([`mark_folds`]): [`RUNS_BACK`] where `q[a] → q[b]`
+/// points against `p[a] → p[b]`, [`CROSSES`] where segment a (a → a + 1) crosses segment b
+/// (b → b + 1) and they are not neighbours.
+#[inline(always)]
+fn pair_folds(p: &[glam::DVec2], q: &[glam::DVec2], a: usize, b: usize) -> u8 {
+    let mut folds = 0;
+    if (q[b] - q[a]).dot(p[b] - p[a]) < 0.0 {
+        folds |= RUNS_BACK;
+    }
+    if b >= a + 2 && b + 1 < q.len() {
+        let (a0, a1, b0, b1) = (q[a], q[a + 1], q[b], q[b + 1]);
+        let apart = a0.max(a1).cmplt(b0.min(b1)).any() || b0.max(b1).cmplt(a0.min(a1)).any();
+        if !apart && crate::geometry::segments_intersect(a0, a1, b0, b1) {
+            folds |= CROSSES;
+        }
+    }
+    folds
 }
 
 /// Columns closer together than this share of their section's typical spacing are squeezed
@@ -484,6 +553,46 @@ fn texture_columns(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// The points [`mark_folds`] marks, in order, each once.
+    fn folds_marked(p: &[glam::DVec2], q: &[glam::DVec2], moved: Option<&[bool]>) -> Vec<usize> {
+        let mut marked = std::collections::BTreeSet::new();
+        let any = mark_folds(p, q, FOLD_REACH, moved, |k| {
+            marked.insert(k);
+        });
+        assert_eq!(any, !marked.is_empty());
+        marked.into_iter().collect()
+    }
+
+    proptest! {
+        /// A stretch searched again only where its marked points moved finds what a whole search
+        /// finds, whatever the marked points are moved to.
+        #[test]
+        fn folds_searched_where_points_moved_are_the_whole_search(
+            radius in proptest::collection::vec(20.0..21.0f64, 40..90),
+            wiggle in proptest::collection::vec(-3.0..3.0f64, 90),
+            moves in proptest::collection::vec((-4.0..4.0f64, -4.0..4.0f64), 90),
+        ) {
+            let n = radius.len();
+            let at = |k: usize, r: f64| {
+                let t = k as f64 * 0.05;
+                glam::DVec2::new(r * t.cos(), r * t.sin())
+            };
+            let p: Vec<glam::DVec2> = (0..n).map(|k| at(k, radius[k])).collect();
+            let q: Vec<glam::DVec2> = (0..n).map(|k| at(k, radius[k] + wiggle[k])).collect();
+            let first = folds_marked(&p, &q, None);
+            let mut moved_q = q.clone();
+            for &k in &first {
+                moved_q[k] += glam::DVec2::from(moves[k]);
+            }
+            let touches = touching(n, &first);
+            prop_assert_eq!(
+                folds_marked(&p, &moved_q, Some(&touches)),
+                folds_marked(&p, &moved_q, None)
+            );
+        }
+    }
 
     /// [`apply_displacements`] as it was written, a whole-surface pass at a time: the reference.
     fn apply_by_passes(
