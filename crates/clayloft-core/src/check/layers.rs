@@ -13,7 +13,6 @@ use super::report::{
     COLLISION, CROSSING, CheckReport, NOT_MEASURED, OVERHANG, PathEvent, Tally, UNSUPPORTED,
     Violation,
 };
-use crate::geometry::point_segment_distance;
 
 mod tree;
 use tree::ChordTree;
@@ -1365,13 +1364,12 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
             return false;
         }
         let p = self.v[j];
-        let mut spot = Found::NONE;
-        self.add_spot(j, id, [p.z - self.reach, p.z - self.below_tol], &mut spot);
-        let Some((_, d, z)) = spot.least_lean else {
+        let Some((z, d)) = self.spot(j, id, [p.z - self.reach, p.z - self.below_tol]) else {
             return false;
         };
-        spot.top_under.is_finite()
-            && !limits.too_thick(p.z - spot.top_under)
+        // Within half a bead: the layer the point rests on is at least this high.
+        d <= self.half_bead
+            && !limits.too_thick(p.z - z)
             // The least lean is at most this one's (its tangent is).
             && d < (p.z - z).max(1e-9) * limits.surely_within_tan
     }
@@ -1546,6 +1544,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
 
     /// Whether the search holds chord `id`: both ends inside the machine, and not steep (as
     /// the tree, when searched, has it already).
+    #[inline]
     fn held(&self, id: usize) -> bool {
         if let ChordIndex::Tree(tree) = self.index {
             return tree.holds(id);
@@ -1576,10 +1575,19 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         if f_line > 1.5 { g < -0.5 } else { g > 1.5 }
     }
 
-    /// Adds to `found` the spot of chord `id` under point j, when it is one: the foot of the
-    /// perpendicular on or near the chord, within `radius` across, at a height within `z`
-    /// (low, high), and not on the bead just laid.
+    /// Adds to `found` the spot of chord `id` under point j, when it is one (see
+    /// [`LayerSearch::spot`]).
     fn add_spot(&self, j: usize, id: usize, z: [f64; 2], found: &mut Found) {
+        if let Some((zq, d)) = self.spot(j, id, z) {
+            found.add(self.v[j].z, zq, d, self.half_bead, id);
+        }
+    }
+
+    /// The spot of chord `id` under point j, its height and distance across, when it is one:
+    /// the foot of the perpendicular on or near the chord, within `radius` across, at a height
+    /// within `z` (low, high), and not on the bead just laid.
+    #[inline]
+    fn spot(&self, j: usize, id: usize, z: [f64; 2]) -> Option<(f64, f64)> {
         let p = self.v[j];
         let pxy = p.truncate();
         let (ia, ib) = self.chords[id];
@@ -1595,12 +1603,14 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         } else {
             0.0
         };
-        let (d, f) = point_segment_distance(pxy, a2, b2);
+        // `point_segment_distance` with the fraction along the line above.
+        let f = f_line.clamp(0.0, 1.0);
+        let d = pxy.distance(a2 + ab * f);
         if d > self.radius
             || !((-0.5..=1.5).contains(&f_line)
                 || d <= self.half_bead && self.past_corner(id, f_line, pxy))
         {
-            return;
+            return None;
         }
         let zq = a.z + (b.z - a.z) * f;
         // The bead just laid: reached from p along an almost straight stretch of path. Where
@@ -1611,11 +1621,9 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         let cum = self.cum;
         let along = cum[j] - (cum[ia] + f * (cum[ib] - cum[ia]));
         if along < self.gap && d >= 0.5 * along && p.z - zq < self.stepped_up {
-            return;
+            return None;
         }
-        if zq <= z[1] && zq >= z[0] {
-            found.add(p.z, zq, d, self.half_bead, id);
-        }
+        (zq <= z[1] && zq >= z[0]).then_some((zq, d))
     }
 }
 

@@ -122,6 +122,7 @@ impl ChordTree {
     }
 
     /// Whether the tree holds chord `id` (the `held` it was built with).
+    #[inline]
     pub(super) fn holds(&self, id: usize) -> bool {
         self.held[id / LEAF] >> (id % LEAF) & 1 == 1
     }
