@@ -108,8 +108,8 @@ pub fn apply_displacements(
     let parts = crate::parallel::ranges(n, 128);
     let typical: Vec<f64> = sections.iter().map(typical_chord).collect();
     let typical = &typical;
-    // Each section's texture faded where it would fold the ring (none where it does not).
-    let faded: Vec<Option<FoldFade>> = {
+    // Each section's normals and shifts, faded where the texture would fold the ring.
+    let faded: Vec<FoldFade> = {
         let sections = &*sections;
         crate::parallel::map_ranges(sections.len(), crate::parallel::PARALLEL_POINTS / n, |ks| {
             ks.map(|k| fold_fade(&sections[k].points, &disp[k], typical[k]))
@@ -119,7 +119,6 @@ pub fn apply_displacements(
     let folds = faded
         .iter()
         .enumerate()
-        .filter_map(|(k, f)| f.as_ref().map(|f| (k, f)))
         .flat_map(|(layer, f)| {
             f.lowered
                 .iter()
@@ -131,14 +130,6 @@ pub fn apply_displacements(
         })
         .collect();
     let faded = &faded;
-    // The columns just outside each part, as they are before the texture.
-    let column = |i: usize| -> Vec<glam::DVec2> {
-        sections.iter().map(|s| s.points[i].truncate()).collect()
-    };
-    let edges: Vec<(Vec<glam::DVec2>, Vec<glam::DVec2>)> = parts
-        .iter()
-        .map(|r| (column((r.start + n - 1) % n), column(r.end % n)))
-        .collect();
     // Each part's columns of every section, to be moved by that part alone.
     let mut columns: Vec<Vec<&mut [glam::DVec3]>> = parts
         .iter()
@@ -152,19 +143,10 @@ pub fn apply_displacements(
             rest = tail;
         }
     }
-    let work = parts.into_iter().zip(columns).zip(edges);
+    let work = parts.into_iter().zip(columns);
     // One part's work (a copy of it for each part: it holds only references).
-    let part_work = move |((cols, part), (left, right)): ((_, _), (Vec<_>, Vec<_>))| {
-        texture_columns(
-            cols,
-            part,
-            (&left, &right),
-            (typical, faded),
-            disp,
-            tan_limit,
-            enforce,
-        )
-    };
+    let part_work =
+        move |(cols, part)| texture_columns(cols, part, faded, disp, tan_limit, enforce);
     let mut overhang = Vec::new();
     if work.len() == 1 {
         for item in work {
@@ -196,18 +178,25 @@ const FOLD_REACH: usize = 16;
 const FOLD_HALVINGS: usize = 6;
 const FOLD_ROUNDS: usize = FOLD_HALVINGS + 4;
 
-/// One section's texture faded where it would fold the wall back on itself.
+/// One section's texture as its points take it: along their outward normals before the
+/// texture, faded where it would fold the wall back on itself.
 #[derive(Debug)]
 struct FoldFade {
-    /// Every point's shift along its outward normal, mm (the squeeze's fade included).
+    /// Every point's outward unit normal in XY before the texture ([`Section::normals`]'s).
+    ///
+    /// [`Section::normals`]: crate::section::Section::normals
+    normals: Vec<glam::DVec2>,
+    /// Every point's shift along it, mm (the squeeze's fade included).
     shifts: Vec<f64>,
     /// The points faded, and by how much, mm.
     lowered: Vec<(usize, f64)>,
 }
 
 /// The texture's shifts on one section (`points`, untextured; `disp`, its displacements;
-/// `typical`, its typical chord), faded where they would fold the ring back on itself; none
-/// when nothing folds (the shifts are then `disp · squeeze_fade`, as the columns find them).
+/// `typical`, its typical chord) and the normals they move the points along, faded where they
+/// would fold the ring back on itself (where nothing folds, the shifts are
+/// `disp · squeeze_fade`). Made once a section, the texture's columns read them
+/// ([`texture_columns`]).
 ///
 /// Displacing along the normals by `s` offsets the wall, and an offset folds where it is deeper
 /// than the wall's radius of curvature there (`s κ > 1`): at a sharp tip pushed in, a sharp
@@ -219,21 +208,45 @@ struct FoldFade {
 /// backwards). The ends of each have their texture halved, round by round, then taken away:
 /// the untextured ring (s = 0) has neither. The fade comes before the overhang's scale,
 /// which is worked out on the faded shifts.
-fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> Option<FoldFade> {
+fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> FoldFade {
     use glam::DVec2;
     let n = points.len();
-    if n < 4 || disp.iter().all(|&d| d == 0.0) {
+    let p = |i: usize| points[i].truncate();
+    let (normals, given): (Vec<DVec2>, Vec<f64>) = (0..n)
+        .map(|i| {
+            let (b, a) = crate::geometry::ring_neighbours(i, n);
+            let shift = disp[i] * squeeze_fade(p(b), p(a), typical);
+            (crate::geometry::normal_from_neighbours(p(b), p(a)), shift)
+        })
+        .unzip();
+    match faded_where_folding(points, &normals, &given) {
+        Some((shifts, lowered)) => FoldFade {
+            normals,
+            shifts,
+            lowered,
+        },
+        None => FoldFade {
+            normals,
+            shifts: given,
+            lowered: Vec::new(),
+        },
+    }
+}
+
+/// [`fold_fade`]'s shifts `given` (along `normals`) of the ring `points` faded where they fold
+/// it, and the points faded by how much; none where nothing folds.
+fn faded_where_folding(
+    points: &[glam::DVec3],
+    normals: &[glam::DVec2],
+    given: &[f64],
+) -> Option<(Vec<f64>, Vec<(usize, f64)>)> {
+    use glam::DVec2;
+    let n = points.len();
+    if n < 4 || given.iter().all(|&s| s == 0.0) {
         return None;
     }
     let at = |i: usize| if i < n { i } else { i - n };
     let p: Vec<DVec2> = points.iter().map(|q| q.truncate()).collect();
-    let (normals, given): (Vec<DVec2>, Vec<f64>) = (0..n)
-        .map(|i| {
-            let (b, a) = crate::geometry::ring_neighbours(i, n);
-            let shift = disp[i] * squeeze_fade(p[b], p[a], typical);
-            (crate::geometry::normal_from_neighbours(p[b], p[a]), shift)
-        })
-        .unzip();
     // Twice the deepest shift: the normals from neighbours spread a corner's turn over two
     // points, so a corner looks half as sharp as it is.
     let deepest = 2.0 * given.iter().fold(0.0_f64, |m, s| m.max(s.abs()));
@@ -271,7 +284,7 @@ fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> Option<FoldF
         stretches = vec![(first, n)];
     }
     let mut q: Vec<DVec2> = (0..n).map(|i| p[i] + normals[i] * given[i]).collect();
-    let mut shifts = given.clone();
+    let mut shifts = given.to_vec();
     let mut folded = vec![false; n];
     // A stretch found clean stays clean: only its own points move. After the first round, a
     // stretch is searched only where its points moved (the points marked the round before).
@@ -312,7 +325,7 @@ fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> Option<FoldF
         .filter(|&i| shifts[i] != given[i])
         .map(|i| (i, (given[i] - shifts[i]).abs()))
         .collect();
-    (!lowered.is_empty()).then_some(FoldFade { shifts, lowered })
+    (!lowered.is_empty()).then_some((shifts, lowered))
 }
 
 /// Which of a stretch's `len` points touch a point of `marked`: the point itself, or the one
@@ -471,55 +484,34 @@ fn admissible_scale(
     allowed.clamp(0.0, 1.0)
 }
 
-/// [`apply_displacements`] on the columns `cols` (`part[k]`: section k's points there; `left`,
-/// `right`: each section's point just before and after them; `typical`: each section's typical
-/// chord; `faded`: each section's shifts where [`fold_fade`] faded them): the normals before the
-/// texture and the displacements faded where the columns are squeezed (or as `faded` has them),
-/// the largest admissible scale of each column and the layer where it binds, the shifts; the
-/// columns scaled down, in order.
+/// [`apply_displacements`] on the columns `cols` (`part[k]`: section k's points there;
+/// `faded`: each section's normals before the texture and its shifts, faded where the columns
+/// are squeezed or the ring would fold, from [`fold_fade`]): the largest admissible scale of
+/// each column and the layer where it binds; the columns moved by their shifts scaled down, in
+/// order.
 fn texture_columns(
     cols: std::ops::Range<usize>,
     mut part: Vec<&mut [glam::DVec3]>,
-    (left, right): (&[glam::DVec2], &[glam::DVec2]),
-    (typical, faded): (&[f64], &[Option<FoldFade>]),
+    faded: &[FoldFade],
     disp: &[Vec<f64>],
     tan_limit: f64,
     enforce: bool,
 ) -> Vec<crate::report::PointEvent> {
     let (w, count) = (cols.len(), part.len());
-    // Outward normals in XY, section-major, as `Section::normals` has them, and each point's
-    // displacement faded by its squeeze.
-    let mut normals = Vec::with_capacity(count * w);
-    let mut shifts = Vec::with_capacity(count * w);
-    for (k, row) in part.iter().enumerate() {
-        let faded = faded[k].as_ref().map(|f| &f.shifts[cols.clone()]);
-        for c in 0..w {
-            let before = if c == 0 {
-                left[k]
-            } else {
-                row[c - 1].truncate()
-            };
-            let after = if c + 1 == w {
-                right[k]
-            } else {
-                row[c + 1].truncate()
-            };
-            normals.push(crate::geometry::normal_from_neighbours(before, after));
-            shifts.push(match faded {
-                Some(faded) => faded[c],
-                None => disp[k][cols.start + c] * squeeze_fade(before, after, typical[k]),
-            });
-        }
-    }
+    // Section k's normals and shifts of these columns.
+    let normals = |k: usize| &faded[k].normals[cols.clone()];
+    let shifts = |k: usize| &faded[k].shifts[cols.clone()];
     // Largest admissible scale per column, and the layer where it binds.
     let mut scale = vec![(1.0_f64, 0_usize); w];
     for k in 1..count {
         let (above, below) = (&part[k], &part[k - 1]);
+        let (normals, normals_below) = (normals(k), normals(k - 1));
+        let (shifts, shifts_below) = (shifts(k), shifts(k - 1));
         for c in 0..w {
             let allowed = admissible_scale(
                 (above[c], below[c]),
-                (normals[k * w + c], normals[(k - 1) * w + c]),
-                (shifts[k * w + c], shifts[(k - 1) * w + c]),
+                (normals[c], normals_below[c]),
+                (shifts[c], shifts_below[c]),
                 tan_limit,
             );
             if allowed < scale[c].0 {
@@ -540,9 +532,10 @@ fn texture_columns(
         }
     }
     for (k, row) in part.iter_mut().enumerate() {
+        let (normals, shifts) = (normals(k), shifts(k));
         for (c, p) in row.iter_mut().enumerate() {
             let s = if enforce { scale[c].0 } else { 1.0 };
-            let shift = normals[k * w + c] * (shifts[k * w + c] * s);
+            let shift = normals[c] * (shifts[c] * s);
             p.x += shift.x;
             p.y += shift.y;
         }
