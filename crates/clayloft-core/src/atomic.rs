@@ -241,10 +241,11 @@ mod tests {
             w.write_all(&data[..100_000])?;
             let file = w.file();
             w.flush()?;
+            let reversed = std::ops::Range { start: 10, end: 3 };
             for range in [
                 0..0,
                 5..5,
-                10..3,
+                reversed,
                 0..4096,
                 90_000..u64::MAX,
                 u64::MAX..u64::MAX,

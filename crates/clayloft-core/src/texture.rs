@@ -233,13 +233,16 @@ fn fold_fade(points: &[glam::DVec3], disp: &[f64], typical: f64) -> FoldFade {
     }
 }
 
+/// Shifts faded where they would fold a ring, and the points faded, by how much (mm).
+type Faded = (Vec<f64>, Vec<(usize, f64)>);
+
 /// [`fold_fade`]'s shifts `given` (along `normals`) of the ring `points` faded where they fold
 /// it, and the points faded by how much; none where nothing folds.
 fn faded_where_folding(
     points: &[glam::DVec3],
     normals: &[glam::DVec2],
     given: &[f64],
-) -> Option<(Vec<f64>, Vec<(usize, f64)>)> {
+) -> Option<Faded> {
     use glam::DVec2;
     let n = points.len();
     if n < 4 || given.iter().all(|&s| s == 0.0) {
