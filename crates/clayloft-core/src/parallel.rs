@@ -481,6 +481,30 @@ pub fn map_ranges<R: Send>(
         .collect()
 }
 
+/// [`map_ranges`] with the items shared out in runs of `run` as the cores get free (see
+/// [`map_shared`]), results concatenated in order: for work whose cost varies along the range
+/// (the sections whose folds are cut off or faded, say), where halves fixed in advance leave
+/// one core idle while the other finishes the harder half.
+pub fn map_runs<R: Send>(
+    len: usize,
+    serial_below: usize,
+    run: usize,
+    f: impl Fn(Range<usize>) -> Vec<R> + Sync,
+) -> Vec<R> {
+    if cores() < 2 || len < serial_below {
+        return f(0..len);
+    }
+    let run = run.max(1);
+    map_shared(
+        len.div_ceil(run),
+        || (),
+        |(), k| f(k * run..((k + 1) * run).min(len)),
+    )
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
 /// `a()` and `b()`, `a` on a helper when `beside` and one is free (else on this thread after
 /// `b`: a part that waits on `b`'s results may be given as `a`).
 pub fn both<A: Send, B>(
@@ -574,12 +598,17 @@ pub fn for_each_part<T: Send>(
 mod tests {
     use super::*;
 
+    /// Parts, runs shared out and parts of a slice cover the range in order, each item once.
     #[test]
     fn parts_cover_the_range_in_order() {
         for len in [0, 1, 2, 7, 100, 1001] {
             for serial in [0, 10, 10_000] {
                 let all: Vec<usize> = map_ranges(len, serial, |r| r.collect());
                 assert_eq!(all, (0..len).collect::<Vec<_>>());
+                for run in [0, 1, 3, 8, 5000] {
+                    let all: Vec<usize> = awake(|| map_runs(len, serial, run, |r| r.collect()));
+                    assert_eq!(all, (0..len).collect::<Vec<_>>(), "{len} {serial} {run}");
+                }
                 let mut v = vec![0usize; len];
                 for_each_part(&mut v, serial, |off, part| {
                     for (j, x) in part.iter_mut().enumerate() {

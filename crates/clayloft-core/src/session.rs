@@ -860,15 +860,21 @@ fn finish_stages(
     Ok(())
 }
 
-/// Shapes the sections `ks` of `model`, split over the machine's cores when there is enough work.
+/// Shapes the sections `ks` of `model`, shared out over the machine's cores in runs of
+/// [`SHAPE_RUN`] when there is enough work (a section whose folds are cut off costs several
+/// times one without).
 fn shape_sections(model: &ShapeModel, ks: &[usize]) -> Vec<(Section, crate::shape::Folds)> {
     let per_section = model.loft.samples().max(1);
-    crate::parallel::map_ranges(
+    crate::parallel::map_runs(
         ks.len(),
         crate::parallel::PARALLEL_POINTS / per_section,
+        SHAPE_RUN,
         |r| ks[r].iter().map(|&k| model.section_with_folds(k)).collect(),
     )
 }
+
+/// Sections a core shapes at a time ([`shape_sections`]).
+const SHAPE_RUN: usize = 8;
 
 #[cfg(test)]
 mod tests {

@@ -108,10 +108,13 @@ pub fn apply_displacements(
     let parts = crate::parallel::ranges(n, 128);
     let typical: Vec<f64> = sections.iter().map(typical_chord).collect();
     let typical = &typical;
-    // Each section's normals and shifts, faded where the texture would fold the ring.
+    // Each section's normals and shifts, faded where the texture would fold the ring: shared
+    // out in runs as the cores get free (a section that folds costs many times one that does
+    // not, and they come in bands of layers).
     let faded: Vec<FoldFade> = {
         let sections = &*sections;
-        crate::parallel::map_ranges(sections.len(), crate::parallel::PARALLEL_POINTS / n, |ks| {
+        let serial_below = crate::parallel::PARALLEL_POINTS / n;
+        crate::parallel::map_runs(sections.len(), serial_below, FOLD_FADE_RUN, |ks| {
             ks.map(|k| fold_fade(&sections[k].points, &disp[k], typical[k]))
                 .collect()
         })
@@ -172,6 +175,9 @@ pub struct TextureLowered {
 /// How far, in samples, [`fold_fade`] looks on either side of a point where the wall turns
 /// more sharply than the texture is deep: a fold whose loop spans up to twice this is seen.
 const FOLD_REACH: usize = 16;
+
+/// Sections a core fades at a time ([`apply_displacements`]).
+const FOLD_FADE_RUN: usize = 8;
 
 /// Rounds of [`fold_fade`] that halve a fold's texture; the next ones take all of it, and after
 /// [`FOLD_ROUNDS`] what still folds is left as it is.
