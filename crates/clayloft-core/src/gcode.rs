@@ -181,7 +181,10 @@ fn summarize_beside<T: Send>(
     let moves = JobMoves::new(design, tp);
     let plan = motion::Plan::new(moves.home, &moves, p.max_acceleration, p.junction_deviation);
     let (other, (time, sums)) = crate::parallel::both(use_beside, beside, || {
-        let sums = PathSums::of(design, tp);
+        // The path's segments are the planner's moves after the approach.
+        let a = moves.approach.len();
+        let segments = plan.lengths().get(a..a + tp.points.len().saturating_sub(1));
+        let sums = PathSums::of(design, tp, segments);
         (plan.time(), sums)
     });
     let summary = JobSummary {
@@ -631,8 +634,10 @@ struct PathSums {
 }
 
 impl PathSums {
-    /// The sums of `tp`'s points, each added in path order as the body's writer adds them.
-    fn of(design: &Design, tp: &Toolpath) -> PathSums {
+    /// The sums of `tp`'s points, each added in path order as the body's writer adds them;
+    /// `segments[i − 1]` is `|p_i − p_{i−1}|` where given (the planner's, the same to the bit:
+    /// the difference's coordinates are the same up to their signs), else measured here.
+    fn of(design: &Design, tp: &Toolpath, segments: Option<&[f64]>) -> PathSums {
         let p = &design.printer;
         let e_per_mm3 = e_per_mm3(p);
         let absolute = p.extrusion == ExtrusionMode::Absolute;
@@ -653,7 +658,10 @@ impl PathSums {
                 percent_times.push(percent_before);
             }
             percent_before = Some(st.t_done);
-            let d = points[i - 1].pos.distance(q.pos);
+            let d = match segments {
+                Some(lengths) => lengths[i - 1],
+                None => points[i - 1].pos.distance(q.pos),
+            };
             length += d;
             st.t_done += d / q.speed;
             let v = segment_volume(design, tp, i);
@@ -1089,6 +1097,12 @@ mod tests {
             let (summary, sums, ()) = summarize_beside(&d, &job, true, || ());
             assert_eq!(summary.path_length_mm.to_bits(), tp.length().to_bits());
             assert_eq!(sums.nominal_s.to_bits(), tp.print_time().to_bits());
+            // The planner's segments, or the path's measured here: the same sums.
+            let measured = PathSums::of(&d, tp, None);
+            assert_eq!(sums.length.to_bits(), measured.length.to_bits());
+            let times = |s: &PathSums| s.starts.iter().map(|b| b.t_done.to_bits()).collect();
+            let times: [Vec<u64>; 2] = [times(&sums), times(&measured)];
+            assert_eq!(times[0], times[1]);
             let volume: f64 = (1..tp.points.len())
                 .map(|i| segment_volume(&d, tp, i))
                 .sum();
@@ -1155,7 +1169,7 @@ mod tests {
                 body.write(
                     &mut text,
                     &mut Some(&mut index),
-                    &body.chunk_starts(&PathSums::of(&d, &tp)),
+                    &body.chunk_starts(&PathSums::of(&d, &tp, None)),
                 )
             })
             .unwrap();

@@ -201,6 +201,12 @@ impl Plan {
         }
     }
 
+    /// Each move's length, mm, `|to − from|` (none where the acceleration is not a positive
+    /// number: nothing was planned).
+    pub fn lengths(&self) -> &[f64] {
+        &self.len
+    }
+
     /// The total time, s: the look-ahead passes and the sum, in path order.
     pub fn time(self) -> f64 {
         let Plan {
