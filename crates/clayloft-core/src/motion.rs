@@ -145,7 +145,16 @@ impl Plan {
         // core for the benchmark vase).
         let (mut len, mut speed) = (Vec::with_capacity(n), Vec::with_capacity(n));
         let mut entry2 = Vec::with_capacity(n + 1);
-        let parts = crate::parallel::ranges(n, serial_below);
+        // Parts of PLAN_PART moves shared out as the cores get free: a textured wall's corners
+        // bind (and cost more) in bands of layers, which halves fixed in advance left to one
+        // core.
+        let parts: Vec<std::ops::Range<usize>> =
+            if crate::parallel::ranges(n, serial_below).len() > 1 {
+                let part = PLAN_PART.min(n.div_ceil(crate::parallel::cores()));
+                (0..n).step_by(part).map(|s| s..(s + part).min(n)).collect()
+            } else {
+                vec![0..n]
+            };
         {
             let (mut len, mut speed, mut entry2) = (
                 &mut len.spare_capacity_mut()[..n],
@@ -166,7 +175,7 @@ impl Plan {
                 let range = range.clone();
                 jobs.push(move || entry_limits(start, moves, range, legs, a, deviation));
             }
-            crate::parallel::run_parts(jobs);
+            crate::parallel::run_shared(jobs);
         }
         // SAFETY: the parts cover 0 .. n, and `entry_limits` writes each move's three values.
         unsafe {
@@ -190,7 +199,7 @@ impl Plan {
                 let end = (p == last).then_some(0.0);
                 jobs.push(move || backward_within(e, l, end, two_a));
             }
-            crate::parallel::run_parts(jobs);
+            crate::parallel::run_shared(jobs);
         }
         Plan {
             a,
@@ -242,6 +251,9 @@ impl Plan {
         total
     }
 }
+
+/// Moves a part of the planner's passes takes (see [`Plan::new`]).
+const PLAN_PART: usize = 16 * 1024;
 
 /// The backward pass over one part of the moves (`entry2` and `len` of its moves): each entry
 /// lowered to what decelerating at `two_a`/2 from the next entry allows, the part's last from

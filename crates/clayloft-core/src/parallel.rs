@@ -246,6 +246,20 @@ pub fn run_parts<R: Send, F: FnOnce() -> R + Send>(parts: Vec<F>) -> Vec<R> {
         .collect()
 }
 
+/// Runs every part, shared out as the cores get free ([`map_shared`]: parts of uneven cost,
+/// more of them than cores); the results in the parts' order.
+pub fn run_shared<R: Send, F: FnOnce() -> R + Send>(parts: Vec<F>) -> Vec<R> {
+    let parts: Vec<Mutex<Option<F>>> = parts.into_iter().map(|f| Mutex::new(Some(f))).collect();
+    map_shared(
+        parts.len(),
+        || (),
+        |(), k| {
+            let part = parts[k].lock().unwrap_or_else(|e| e.into_inner()).take();
+            part.expect("each part taken once")()
+        },
+    )
+}
+
 /// Work started on a free helper while this thread goes on ([`beside`]); [`Beside::join`]
 /// gives its result.
 pub struct Beside<T> {
@@ -657,6 +671,31 @@ mod tests {
                 assert!(states.load(Ordering::Relaxed) <= cores().min(count.max(1)));
             }
         });
+    }
+
+    /// Parts shared out come back in their order, each run once, however uneven.
+    #[test]
+    fn shared_parts_come_back_in_order_each_run_once() {
+        let runs = AtomicUsize::new(0);
+        for count in [0, 1, 2, 13] {
+            runs.store(0, Ordering::Relaxed);
+            let runs = &runs;
+            let parts: Vec<_> = (0..count)
+                .map(|k| {
+                    move || {
+                        runs.fetch_add(1, Ordering::Relaxed);
+                        let spin = if k % 5 == 0 { 100_000 } else { 10 };
+                        (k, (0..spin).sum::<u64>())
+                    }
+                })
+                .collect();
+            let got = awake(|| run_shared(parts));
+            let expected: Vec<(usize, u64)> = (0..count)
+                .map(|k| (k, (0..if k % 5 == 0 { 100_000 } else { 10 }).sum::<u64>()))
+                .collect();
+            assert_eq!(got, expected);
+            assert_eq!(runs.load(Ordering::Relaxed), count);
+        }
     }
 
     /// Parts handed to the helpers: results in order whoever runs them, parts started from
