@@ -153,7 +153,7 @@ impl Plan {
                 let part = PLAN_PART.min(n.div_ceil(crate::parallel::cores()));
                 (0..n).step_by(part).map(|s| s..(s + part).min(n)).collect()
             } else {
-                vec![0..n]
+                std::iter::once(0..n).collect()
             };
         {
             let (mut len, mut speed, mut entry2) = (
