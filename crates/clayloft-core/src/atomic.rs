@@ -170,7 +170,7 @@ pub fn prepare<T>(
     }
     let filled = {
         // Small writes (a header's lines, an STL's triangles) are gathered; a write of at least
-        // the buffer's size (a G-code body's chunk of 300 kB) goes to the file as it is, not
+        // the buffer's size (a G-code body's chunk of 150 kB) goes to the file as it is, not
         // copied into the buffer first (8 MB copied for the benchmark vase with a 1 MB buffer).
         let mut w = Output {
             writer: BufWriter::with_capacity(WRITE_BUFFER, tmp.as_file()),
@@ -196,10 +196,10 @@ pub fn prepare<T>(
 const WRITE_BUFFER: usize = 64 << 10;
 
 /// Starts the data of `file` in `bytes` (to the end of the file, for an end past it) for the
-/// disk without waiting for it. A rename that replaces a file on ext4 writes the new file's data out first
-/// (`auto_da_alloc`, which keeps a crash from leaving it empty): 4–5 ms for the benchmark
-/// vase's 8 MB inside `Pending::commit`; started once the file is written, the rename takes
-/// about 2 ms (the old file's pages freed), and the start itself 0.6–1.5 ms on one core.
+/// disk without waiting for it. A rename that replaces a file on ext4 writes the new file's
+/// data out first (`auto_da_alloc`, which keeps a crash from leaving it empty): 4–5 ms for the
+/// benchmark vase's 8 MB inside `Pending::commit`; started once the file is written, the rename
+/// takes about 2 ms (the old file's pages freed), and the start itself 0.6–1.5 ms on one core.
 /// Started part by part as they are written, on a core with time to spare (`clayloft gcode`
 /// starts each round of its body while the next is written), it leaves little to start at the
 /// end. A hint only: data not written yet, or already started, is passed over, and if the call
