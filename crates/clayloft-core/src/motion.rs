@@ -148,13 +148,7 @@ impl Plan {
         // Parts of PLAN_PART moves shared out as the cores get free: a textured wall's corners
         // bind (and cost more) in bands of layers, which halves fixed in advance left to one
         // core.
-        let parts: Vec<std::ops::Range<usize>> =
-            if crate::parallel::ranges(n, serial_below).len() > 1 {
-                let part = PLAN_PART.min(n.div_ceil(crate::parallel::cores()));
-                (0..n).step_by(part).map(|s| s..(s + part).min(n)).collect()
-            } else {
-                std::iter::once(0..n).collect()
-            };
+        let parts = crate::parallel::runs(n, serial_below, PLAN_PART);
         {
             let (mut len, mut speed, mut entry2) = (
                 &mut len.spare_capacity_mut()[..n],

@@ -505,18 +505,28 @@ pub fn map_runs<R: Send>(
     run: usize,
     f: impl Fn(Range<usize>) -> Vec<R> + Sync,
 ) -> Vec<R> {
-    if cores() < 2 || len < serial_below {
+    let runs = runs(len, serial_below, run);
+    if runs.len() == 1 {
         return f(0..len);
     }
-    let run = run.max(1);
-    map_shared(
-        len.div_ceil(run),
-        || (),
-        |(), k| f(k * run..((k + 1) * run).min(len)),
-    )
-    .into_iter()
-    .flatten()
-    .collect()
+    map_shared(runs.len(), || (), |(), k| f(runs[k].clone()))
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// `0..len` cut into runs of `run` items to be shared out as the cores get free (no longer than
+/// a core's even share, so that a short range is still split), or left whole where
+/// [`ranges`] leaves it whole (one core, or fewer than `serial_below` items).
+pub fn runs(len: usize, serial_below: usize, run: usize) -> Vec<Range<usize>> {
+    if ranges(len, serial_below).len() < 2 {
+        return std::iter::once(0..len).collect();
+    }
+    let run = run.min(len.div_ceil(cores())).max(1);
+    (0..len)
+        .step_by(run)
+        .map(|s| s..(s + run).min(len))
+        .collect()
 }
 
 /// `a()` and `b()`, `a` on a helper when `beside` and one is free (else on this thread after
@@ -622,6 +632,8 @@ mod tests {
                 for run in [0, 1, 3, 8, 5000] {
                     let all: Vec<usize> = awake(|| map_runs(len, serial, run, |r| r.collect()));
                     assert_eq!(all, (0..len).collect::<Vec<_>>(), "{len} {serial} {run}");
+                    let cut: Vec<usize> = runs(len, serial, run).into_iter().flatten().collect();
+                    assert_eq!(cut, (0..len).collect::<Vec<_>>(), "{len} {serial} {run}");
                 }
                 let mut v = vec![0usize; len];
                 for_each_part(&mut v, serial, |off, part| {
