@@ -3,7 +3,8 @@
 # item 5): PrusaSlicer's spiral vase slicing Clayloft's STL of the vessel, and FullControl writing
 # the same spiral (Clayloft's points as fc.Point steps; only FullControl's transform and file
 # write are timed). Not part of CI: it installs PrusaSlicer (Debian) and FullControl (PyPI).
-#   scripts/peers/bench.sh            # three runs of each, wall-clock seconds
+#   scripts/peers/bench.sh                 # five rounds: ratios of medians and of minimums
+#   scripts/peers/bench.sh --rounds 10     # (options of scripts/peers/ratios.py)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 target="${CARGO_TARGET_DIR:-$HOME/.cache/clayloft-target}"
@@ -17,15 +18,6 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 design=assets/benchmarks/vase-720x300.toml
 "$clayloft" stl "$design" -o "$work/vase.stl" >/dev/null
-secs() { /usr/bin/time -f %e "$@" 2>&1 >/dev/null | tail -n1; }
-for run in 1 2 3; do
-  echo "run $run"
-  echo "  clayloft gcode:            $(secs "$clayloft" gcode "$design" -o "$work/vase.gcode") s"
-  echo "  prusa-slicer spiral vase:  $(secs prusa-slicer --export-gcode --spiral-vase \
-      --nozzle-diameter 3 --extrusion-width 3 --layer-height 0.5 --first-layer-height 0.5 \
-      --perimeters 1 --bottom-solid-layers 2 --top-solid-layers 0 --fill-density 0 \
-      --bed-shape 0x0,300x0,300x300,0x300 --center 150,150 --max-print-height 400 \
-      -o "$work/prusa.gcode" "$work/vase.stl") s"
-  echo "  fullcontrol (transform):   $("$venv/bin/python" scripts/peers/fullcontrol_spiral.py \
-      "$work/vase.gcode" "$work/fc.gcode")"
-done
+# Rounds of ten `clayloft gcode` runs, one PrusaSlicer run and one FullControl run, the ratios
+# of their medians and of their minimums at the end (ratios.py).
+"$venv/bin/python" scripts/peers/ratios.py "$clayloft" prusa-slicer "$venv/bin/python" "$work" "$@"

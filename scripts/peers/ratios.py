@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""How many times faster `clayloft gcode` is than the peers on the benchmark vessel (issue 14
+item 5), measured in the same minutes: each round runs Clayloft's whole process `--clayloft-runs`
+times, then PrusaSlicer's spiral vase once, then FullControl's transform once, so that the
+machine's drifting speed falls on all three alike. Called by `bench.sh`, which installs the peers.
+
+    ratios.py CLAYLOFT PRUSA_SLICER FC_PYTHON WORK_DIR [--rounds 5] [--clayloft-runs 10]
+
+Prints each round's times, then the medians and minimums of each tool (ms) and the ratios of
+median to median and of minimum to minimum. Clayloft is timed as a whole process (start to exit,
+`os.wait4`); PrusaSlicer as a whole process too; FullControl only for its own work (steps to
+G-code text to file, timed inside Python by `fullcontrol_spiral.py`, which reads the points
+from Clayloft's G-code first).
+"""
+import argparse
+import os
+import re
+import statistics
+import subprocess
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+DESIGN = ROOT / "assets/benchmarks/vase-720x300.toml"
+
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("clayloft")
+parser.add_argument("prusa_slicer")
+parser.add_argument("fc_python")
+parser.add_argument("work")
+parser.add_argument("--rounds", type=int, default=5)
+parser.add_argument("--clayloft-runs", type=int, default=10)
+args = parser.parse_args()
+work = Path(args.work)
+
+
+def wall_ms(cmd):
+    """Runs `cmd` to its end, its output discarded; its wall time in ms (fails loudly)."""
+    start = time.perf_counter()
+    child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, status, _ = os.wait4(child.pid, 0)
+    elapsed = (time.perf_counter() - start) * 1000
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"failed: {' '.join(map(str, cmd))}")
+    return elapsed
+
+
+clayloft_gcode = work / "vase.gcode"
+prusa = [args.prusa_slicer, "--export-gcode", "--spiral-vase",
+         "--nozzle-diameter", "3", "--extrusion-width", "3", "--layer-height", "0.5",
+         "--first-layer-height", "0.5", "--perimeters", "1", "--bottom-solid-layers", "2",
+         "--top-solid-layers", "0", "--fill-density", "0",
+         "--bed-shape", "0x0,300x0,300x300,0x300", "--center", "150,150",
+         "--max-print-height", "400", "-o", str(work / "prusa.gcode"), str(work / "vase.stl")]
+fullcontrol = [args.fc_python, str(ROOT / "scripts/peers/fullcontrol_spiral.py"),
+               str(clayloft_gcode), str(work / "fc.gcode")]
+
+times = {"clayloft": [], "prusaslicer": [], "fullcontrol": []}
+for r in range(args.rounds):
+    ours = [wall_ms([args.clayloft, "gcode", str(DESIGN), "-o", str(clayloft_gcode)])
+            for _ in range(args.clayloft_runs)]
+    times["clayloft"] += ours
+    times["prusaslicer"].append(wall_ms(prusa))
+    said = subprocess.run(fullcontrol, capture_output=True, text=True, check=True).stdout
+    seconds = re.search(r"points, ([0-9.]+) s", said)
+    if not seconds:
+        raise SystemExit(f"fullcontrol_spiral.py said: {said!r}")
+    times["fullcontrol"].append(float(seconds.group(1)) * 1000)
+    print(f"round {r + 1}: clayloft median {statistics.median(ours):.1f} ms, "
+          f"prusaslicer {times['prusaslicer'][-1]:.0f} ms, "
+          f"fullcontrol {times['fullcontrol'][-1]:.0f} ms")
+
+median = {k: statistics.median(v) for k, v in times.items()}
+least = {k: min(v) for k, v in times.items()}
+for k in times:
+    print(f"{k}: median {median[k]:.1f} ms, minimum {least[k]:.1f} ms ({len(times[k])} runs)")
+for peer, goal in (("prusaslicer", 100), ("fullcontrol", 50)):
+    print(f"clayloft vs {peer}: {median[peer] / median['clayloft']:.0f}x median to median, "
+          f"{least[peer] / least['clayloft']:.0f}x minimum to minimum (goal {goal}x)")
