@@ -31,6 +31,8 @@ parser.add_argument("work")
 parser.add_argument("--rounds", type=int, default=5)
 parser.add_argument("--clayloft-runs", type=int, default=10)
 args = parser.parse_args()
+if args.rounds < 1 or args.clayloft_runs < 1:
+    parser.error("--rounds and --clayloft-runs must be at least 1")
 work = Path(args.work)
 
 
