@@ -14,7 +14,7 @@ CLAYLOFT_AUTOSAVE_DIR="$autosave" xvfb-run -a -s "-screen 0 1280x720x24" \
 wrapper=$!
 pid=""
 for _ in $(seq 1 100); do
-  pid="$(pgrep -n -x clayloft || true)"
+  pid="$(pgrep -n -x 'clayloft(-editor)?' || true)"
   [ -n "$pid" ] && break
   sleep 0.2
 done

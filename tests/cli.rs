@@ -845,6 +845,45 @@ fn editor_and_screenshot_reject_bad_input_before_opening_a_window() {
     assert!(!png.exists());
 }
 
+/// `clayloft` is the command line without the application's window code (a batch command
+/// starts as a small program); it hands the commands that open a window to `clayloft-editor`
+/// next to it, which refuses a bad design the same way (above), and says so where that program
+/// is missing.
+#[test]
+fn the_command_line_hands_windows_to_the_editor_program_next_to_it() {
+    let cli = std::fs::read(env!("CARGO_BIN_EXE_clayloft")).unwrap();
+    let editor = std::fs::read(env!("CARGO_BIN_EXE_clayloft-editor")).unwrap();
+    let links_the_app = |bin: &[u8]| {
+        bin.windows(b"bevy_ecs".len())
+            .any(|w| w == b"bevy_ecs".as_slice())
+    };
+    assert!(links_the_app(&editor), "the editor program holds the app");
+    assert!(
+        !links_the_app(&cli),
+        "the command line links the app's code ({} MB)",
+        cli.len() >> 20
+    );
+    // Alone in a folder, it still runs its own commands, and names what a window needs.
+    let dir = tempfile::tempdir().unwrap();
+    let lone = dir
+        .path()
+        .join(format!("clayloft{}", std::env::consts::EXE_SUFFIX));
+    std::fs::copy(env!("CARGO_BIN_EXE_clayloft"), &lone).unwrap();
+    let run = |args: &[&str]| {
+        Command::new(&lone)
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .unwrap()
+    };
+    assert!(run(&["printers"]).status.success());
+    let out = run(&["assets/designs/petal-vase.toml"]);
+    assert_bad_input(&out, &["clayloft-editor", "cannot start the editor"]);
+    // Its arguments are checked before anything is handed over.
+    let out = run(&["screenshot", "-o", "x.png", "--width", "10"]);
+    assert_bad_input(&out, &["10 × 720", "64 … 8192"]);
+}
+
 #[test]
 fn bad_pictures_and_drawings_exit_2_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
