@@ -618,6 +618,19 @@ pub fn for_each_part<T: Send>(
     );
 }
 
+/// `v.extend_from_slice(items)`, the copy in parts on every core where `items` has at least
+/// `serial_below` of them (a copy of megabytes, which one core makes at the memory's pace).
+pub fn extend_from_slice<T: Copy + Send + Sync>(v: &mut Vec<T>, items: &[T], serial_below: usize) {
+    v.reserve(items.len());
+    let room = &mut v.spare_capacity_mut()[..items.len()];
+    for_each_part(room, serial_below, |offset, part| {
+        part.write_copy_of_slice(&items[offset..offset + part.len()]);
+    });
+    // SAFETY: the parts cover the first `items.len()` places of the spare capacity, each
+    // written above.
+    unsafe { v.set_len(v.len() + items.len()) };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -643,6 +656,19 @@ mod tests {
                 });
                 assert_eq!(v, (0..len).collect::<Vec<_>>());
             }
+        }
+    }
+
+    /// A slice appended in parts is the slice appended, whatever its length.
+    #[test]
+    fn a_slice_appended_in_parts_is_appended_whole() {
+        for len in [0, 1, 2, 7, 1001, 50_000] {
+            let items: Vec<u64> = (0..len as u64).map(|k| k * 7 + 3).collect();
+            let mut v = vec![1u64, 2];
+            awake(|| extend_from_slice(&mut v, &items, 10));
+            let mut whole = vec![1u64, 2];
+            whole.extend_from_slice(&items);
+            assert_eq!(v, whole);
         }
     }
 

@@ -417,7 +417,12 @@ fn build_toolpath_split(
     let helix_made = match halves {
         Some((later, ())) if later.from == state => {
             let offset = b.points.len();
-            b.points.extend_from_slice(&later.points[later.skip..]);
+            // Megabytes: copied on both cores.
+            crate::parallel::extend_from_slice(
+                &mut b.points,
+                &later.points[later.skip..],
+                crate::parallel::PARALLEL_POINTS,
+            );
             layer_starts.extend(later.starts.iter().map(|s| s - later.skip + offset));
             state = later.to;
             HelixHalves::Kept
