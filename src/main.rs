@@ -41,6 +41,8 @@ fn hand_to_editor(_: Window) -> Result<ExitCode, Failure> {
     #[cfg(not(unix))]
     {
         let status = command.status().map_err(not_started)?;
-        Ok(ExitCode::from(status.code().map_or(2, |c| c as u8)))
+        Ok(ExitCode::from(
+            status.code().map_or(2, |c| u8::try_from(c).unwrap_or(2)),
+        ))
     }
 }
