@@ -14,7 +14,8 @@ CLAYLOFT_AUTOSAVE_DIR="$autosave" xvfb-run -a -s "-screen 0 1280x720x24" \
 wrapper=$!
 pid=""
 for _ in $(seq 1 100); do
-  pid="$(pgrep -n -x 'clayloft(-editor)?' || true)"
+  # `clayloft` hands the window to `clayloft-editor` in the same process, under that name.
+  pid="$(pgrep -n -x clayloft-editor || pgrep -n -x clayloft || true)"
   [ -n "$pid" ] && break
   sleep 0.2
 done
