@@ -1,8 +1,7 @@
-//! The command line (SPEC §7), shared by both binaries: `clayloft`, which holds no window code
-//! and hands the commands that open one to `clayloft-editor` next to it, and `clayloft-editor`,
-//! the application (SPEC §8) with the same commands. Thin: every piece of work is a call into
-//! `clayloft-core` or a plugin; this file only parses arguments, prints summaries and maps
-//! errors to exit codes (0 = done, 1 = check found violations, 2 = bad input).
+//! The command line (SPEC §7) of both programs (see the crate's documentation). Thin: every
+//! piece of work is a call into `clayloft-core` or a plugin; this file only parses arguments,
+//! prints summaries and maps errors to exit codes (0 = done, 1 = check found violations,
+//! 2 = bad input).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -153,9 +152,8 @@ fn quiet_on_broken_pipe() {
     }));
 }
 
-/// A command that opens a window: the editor on a design, or a picture of its view.
-// Read by `clayloft-editor`; `clayloft` passes its arguments on as they came.
-#[allow(dead_code)]
+/// A command that opens a window: the editor on a design, or a picture of its view (read by
+/// `clayloft-editor`; `clayloft` passes its arguments on as they came).
 pub enum Window {
     Editor(PathBuf),
     Screenshot {

@@ -1,17 +1,14 @@
-//! `clayloft-editor`: the application (SPEC §8, [`app`]) with the whole command line ([`cli`]);
-//! `clayloft` hands it the commands that open a window.
+//! `clayloft-editor`: the application (SPEC §8, [`app`]) with the whole command line
+//! ([`clayloft::cli`]); `clayloft` hands it the commands that open a window.
 
 mod app;
-mod cli;
-mod flow;
-mod printer;
 mod screenshot;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use clayloft::cli::{self, Failure, Window, job_of};
 use clayloft_core::load_design;
-use cli::{Failure, Window, job_of};
 
 fn main() -> ExitCode {
     cli::main(open)
@@ -38,7 +35,8 @@ fn editor(design: PathBuf) -> Result<ExitCode, Failure> {
     Ok(app::run(loaded.design, loaded.path, None))
 }
 
-/// `clayloft screenshot [DESIGN] -o OUT.png [--progress F]` (its arguments checked by [`cli`]).
+/// `clayloft screenshot [DESIGN] -o OUT.png [--progress F]` (its arguments checked by
+/// [`cli`]).
 fn shoot(
     design: PathBuf,
     out: PathBuf,

@@ -5,13 +5,9 @@
 //! (`clayloft [DESIGN]`, `clayloft screenshot`) are handed, with their arguments, to
 //! `clayloft-editor` next to this program (built with it), which runs them in the same process.
 
-mod cli;
-mod flow;
-mod printer;
-
 use std::process::ExitCode;
 
-use cli::{Failure, Window};
+use clayloft::cli::{self, Failure, Window};
 
 fn main() -> ExitCode {
     cli::main(hand_to_editor)
