@@ -1230,6 +1230,136 @@ mod properties {
     use crate::pipeline::run;
     use proptest::prelude::*;
 
+    /// A rose-to-circle vessel with a belly (see [`any_vessel_gives_one_printable_spiral`]).
+    struct Vessel {
+        r_low: f64,
+        r_up: f64,
+        amp: f64,
+        petals: usize,
+        height: f64,
+        belly: f64,
+        base: usize,
+        samples: usize,
+        half_layers: bool,
+        min_share: f64,
+        walls: usize,
+    }
+
+    /// Checks that `v` gives one continuous path whose points all lie within the printer's
+    /// layer-height range, with no segment longer than a few sample spacings (no hidden
+    /// travel), and a surface within the overhang limit.
+    fn gives_one_printable_spiral(v: &Vessel) -> Result<(), TestCaseError> {
+        // Layers of 1 mm or 0.5 mm, a minimum from a quarter of them up to all of them (at
+        // most half the printer's 1 mm maximum: the validator's bound for leaving the flat
+        // layer), one bead or two where the validator lets two leave it.
+        let layer: f64 = if v.half_layers { 0.5 } else { 1.0 };
+        let min = (layer * v.min_share).min(0.5);
+        let two_fit = layer >= 2.0 * min && super::first_revolution_top(layer, min, 2) <= 1.0;
+        let walls = if two_fit { v.walls } else { 1 };
+        let d = parse_design(&format!(
+            "version = 1\n[printer]\nlayer_height = {layer}\nmin_layer_height = {min}\n\
+             [shape]\nheight = {}\nsamples = {}\nbase_layers = {}\nwalls = {walls}\n\
+             [shape.lower]\ntype = \"circle\"\nradius = {}\n\
+             [shape.upper]\ntype = \"rose\"\nradius = {}\namplitude = {}\npetals = {}\n\
+             [[control.vertical]]\npoints = [[0.0, 0.0], [0.5, {}], [1.0, 0.0]]\n",
+            v.height,
+            v.samples,
+            v.base,
+            v.r_low,
+            v.r_up,
+            v.amp * v.r_up,
+            v.petals,
+            v.belly,
+        ))
+        .unwrap();
+        let job = run(&d).unwrap();
+        let pts = &job.toolpath.points;
+        // No segment longer than the widest gap between neighbouring section points (plus
+        // the step from one section to the next): no hidden travel.
+        let widest = job
+            .surface
+            .sections
+            .iter()
+            .flat_map(|s| {
+                let n = s.points.len();
+                (0..n).map(move |i| {
+                    s.points[i]
+                        .truncate()
+                        .distance(s.points[(i + 1) % n].truncate())
+                })
+            })
+            .fold(0.0, f64::max);
+        for w in pts.windows(2) {
+            let seg = w[0].pos.truncate().distance(w[1].pos.truncate());
+            // The base's bridges and corner spurs step about a bead across; the outline's
+            // bridge steps back out to where it stepped in, a bead along (√2 beads, and
+            // more where a flaring foot's outline has moved out from the rings inside).
+            prop_assert!(
+                seg > 0.0 && seg <= widest + 2.0 * d.printer.line_width,
+                "segment {seg} > {widest}"
+            );
+        }
+        for q in pts {
+            prop_assert!(
+                q.thickness >= d.printer.min_layer_height - 1e-9,
+                "thin {}",
+                q.thickness
+            );
+            prop_assert!(
+                q.thickness <= d.printer.max_layer_height + 1e-9,
+                "thick {}",
+                q.thickness
+            );
+        }
+        prop_assert!(job.surface.metrics.max_overhang_deg <= d.printer.max_overhang_deg + 1e-6);
+        Ok(())
+    }
+
+    /// A 103 mm foot under a 40 mm seven-petal rim 10 mm up, with a belly, two beads: the
+    /// overhang clamp pulls the wall in by 32 mm. It kept each point's slide along the wall
+    /// while cutting its step in to a fraction of a millimetre, the top sections zigzagged,
+    /// the inner bead started 43 mm from the outer one's seam (a 27 mm step the test caught)
+    /// and the design was refused as "layer too thin".
+    #[test]
+    fn a_wall_pulled_in_tens_of_millimetres_stays_one_spiral() {
+        let v = Vessel {
+            r_low: 51.29040566244699,
+            r_up: 20.0,
+            amp: 0.29792647984443354,
+            petals: 7,
+            height: 10.0,
+            belly: 9.889728059747194,
+            base: 0,
+            samples: 106,
+            half_layers: true,
+            min_share: 0.25,
+            walls: 2,
+        };
+        gives_one_printable_spiral(&v).unwrap();
+    }
+
+    /// A 40 mm foot flaring to a 105 mm eight-petal rim 18 mm up, two beads: the clamp's
+    /// samples bunch at the corners below, and a point beside a bunch was taken to have slid
+    /// past it and left unclamped, 10 mm out; the inner bead's offset then split ("narrower
+    /// than 2 beads", refused).
+    #[test]
+    fn a_wall_flared_out_tens_of_millimetres_stays_one_spiral() {
+        let v = Vessel {
+            r_low: 20.0,
+            r_up: 52.43772271677046,
+            amp: 0.21840012045685658,
+            petals: 8,
+            height: 18.482113276551672,
+            belly: -6.869430249359267,
+            base: 0,
+            samples: 241,
+            half_layers: false,
+            min_share: 0.25,
+            walls: 2,
+        };
+        gives_one_printable_spiral(&v).unwrap();
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(24))]
         /// For any rose-to-circle vessel with a belly and any base: one continuous path whose
@@ -1241,41 +1371,9 @@ mod properties {
             height in 10.0..80.0f64, belly in -10.0..10.0f64, base in 0usize..4, samples in 60usize..300,
             half_layers in proptest::bool::ANY, min_share in 0.25..=1.0f64, walls in 1usize..3,
         ) {
-            // Layers of 1 mm or 0.5 mm, a minimum from a quarter of them up to all of them (at
-            // most half the printer's 1 mm maximum: the validator's bound for leaving the flat
-            // layer), one bead or two where the validator lets two leave it.
-            let layer: f64 = if half_layers { 0.5 } else { 1.0 };
-            let min = (layer * min_share).min(0.5);
-            let two_fit = layer >= 2.0 * min && super::first_revolution_top(layer, min, 2) <= 1.0;
-            let walls = if two_fit { walls } else { 1 };
-            let d = parse_design(&format!(
-                "version = 1\n[printer]\nlayer_height = {layer}\nmin_layer_height = {min}\n\
-                 [shape]\nheight = {height}\nsamples = {samples}\nbase_layers = {base}\nwalls = {walls}\n\
-                 [shape.lower]\ntype = \"circle\"\nradius = {r_low}\n\
-                 [shape.upper]\ntype = \"rose\"\nradius = {r_up}\namplitude = {}\npetals = {petals}\n\
-                 [[control.vertical]]\npoints = [[0.0, 0.0], [0.5, {belly}], [1.0, 0.0]]\n",
-                amp * r_up
-            )).unwrap();
-            let job = run(&d).unwrap();
-            let pts = &job.toolpath.points;
-            // No segment longer than the widest gap between neighbouring section points (plus
-            // the step from one section to the next): no hidden travel.
-            let widest = job.surface.sections.iter().flat_map(|s| {
-                let n = s.points.len();
-                (0..n).map(move |i| s.points[i].truncate().distance(s.points[(i + 1) % n].truncate()))
-            }).fold(0.0, f64::max);
-            for w in pts.windows(2) {
-                let seg = w[0].pos.truncate().distance(w[1].pos.truncate());
-                // The base's bridges and corner spurs step about a bead across; the outline's
-                // bridge steps back out to where it stepped in, a bead along (√2 beads, and
-                // more where a flaring foot's outline has moved out from the rings inside).
-                prop_assert!(seg > 0.0 && seg <= widest + 2.0 * d.printer.line_width, "segment {seg} > {widest}");
-            }
-            for q in pts {
-                prop_assert!(q.thickness >= d.printer.min_layer_height - 1e-9, "thin {}", q.thickness);
-                prop_assert!(q.thickness <= d.printer.max_layer_height + 1e-9, "thick {}", q.thickness);
-            }
-            prop_assert!(job.surface.metrics.max_overhang_deg <= d.printer.max_overhang_deg + 1e-6);
+            gives_one_printable_spiral(&Vessel {
+                r_low, r_up, amp, petals, height, belly, base, samples, half_layers, min_share, walls,
+            })?;
         }
     }
 }
