@@ -151,12 +151,13 @@ pub struct TextureKey {
     pub sections: usize,
 }
 
-/// Inputs of the base fill: the feet it fills and the bead width (and the wall's length, which
-/// bounds the path).
+/// Inputs of the base fill: the feet it fills, the bead width, the beads of the wall on it
+/// (the rings under them are laid all round) and the wall's length, which bounds the path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BaseKey {
     pub feet: Vec<Vec<DVec2>>,
     pub line_width: f64,
+    pub walls: usize,
     pub wall: (usize, usize),
 }
 
@@ -796,6 +797,7 @@ fn finish_stages(
     let key = BaseKey {
         feet: crate::toolpath::base_feet(design, &surface),
         line_width: p.line_width,
+        walls: design.shape.walls,
         wall: (surface.layers, surface.sections[0].points.len()),
     };
     later.base.refresh(key, || {

@@ -230,7 +230,7 @@ pub fn base_fills_then(
             ));
         }
     }
-    crate::base_fill::fill_feet_then(&feet, p.line_width, rings_made).map_err(|e| {
+    crate::base_fill::fill_feet_then(&feet, p.line_width, design.shape.walls, rings_made).map_err(|e| {
         FieldError::new(
             "shape.base_layers",
             match e {
