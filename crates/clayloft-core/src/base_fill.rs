@@ -1087,16 +1087,20 @@ mod tests {
         }
     }
 
+    /// A six-point star of outer radius 50 mm and inner radius `inner`, as `n` points.
+    fn six_point_star(inner: f64, n: usize) -> Vec<DVec2> {
+        let corners: Vec<DVec2> = (0..12)
+            .map(|i| {
+                DVec2::from_angle(TAU * i as f64 / 12.0) * if i % 2 == 0 { 50.0 } else { inner }
+            })
+            .collect();
+        crate::geometry::resample_closed(&corners, n)
+    }
+
     #[test]
     fn deep_star() {
         // Six points, outer radius 50, inner 22 (the star): not scaled copies.
-        let star: Vec<DVec2> = (0..12)
-            .map(|i| {
-                DVec2::from_angle(TAU * i as f64 / 12.0) * if i % 2 == 0 { 50.0 } else { 22.0 }
-            })
-            .collect();
-        let star = crate::geometry::resample_closed(&star, 720);
-        check("star", &star);
+        check("star", &six_point_star(22.0, 720));
     }
 
     /// Under a wall of two beads the ring a bead in is laid all the way round, like the
@@ -1104,12 +1108,7 @@ mod tests {
     /// leaned the inner bead 48° at the gap). Under one bead it is left open there.
     #[test]
     fn the_rings_under_a_wall_s_beads_are_laid_all_round() {
-        let star: Vec<DVec2> = (0..12)
-            .map(|i| {
-                DVec2::from_angle(TAU * i as f64 / 12.0) * if i % 2 == 0 { 50.0 } else { 30.0 }
-            })
-            .collect();
-        let star = crate::geometry::resample_closed(&star, 360);
+        let star = six_point_star(30.0, 360);
         let ring = inward_offset(&star, W).expect("one ring a bead in");
         let ring = crate::geometry::resample_closed(&ring, 4000); // every 0.06 bead
         // How far the ring's points lie from the path at most.
