@@ -793,10 +793,10 @@ pub fn fill_feet(feet: &[Vec<DVec2>], w: f64) -> Result<Vec<BaseFill>, FillError
 /// other work beside it.
 ///
 /// The outline and the `walls − 1` rings inside it are laid all round (their bridges step back
-/// out where they stepped in): the wall's first revolution rests its beads on them. A ring
-/// left open where its bridge inward leaves it has half a bead of nothing under the inner bead
-/// there, which leans it past the limit (found by the checker on 14 of 450 random designs with
-/// two beads on one base layer, 47–51°).
+/// out where they stepped in): the wall's first revolution rests its beads on them. The ring
+/// inside the outline, left open a bead where the path comes back out of it, had nothing under
+/// the inner bead there but the two steps, which leaned it past the limit (found by the checker
+/// on 14 of 450 random designs with two beads on one base layer, 47–57°).
 pub fn fill_feet_then(
     feet: &[Vec<DVec2>],
     w: f64,

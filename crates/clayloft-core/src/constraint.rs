@@ -287,8 +287,10 @@ fn nearest_on(xy: DVec2, points: &[glam::DVec3]) -> (f64, DVec2, bool) {
 }
 
 /// How far, in layer limits (`tan_limit · Δz`), a point's offset along the normal may reach
-/// before [`clamp_point`] scales its slide along the wall back with it: three limits, the
-/// smallest reach at which none of 450 random designs that printed before is refused after.
+/// before [`clamp_point`] scales its slide along the wall back with it: three limits. Of the 450
+/// random designs, with one or two limits one that printed before was refused (a layer 0.02 mm
+/// too thin at one point) and 19–20 more printed; with three none was refused and 11 more
+/// printed.
 const SLIDE_REACH_LIMITS: f64 = 3.0;
 
 /// `xy`, a point brought back along the normal `n` from an offset `offset` (> `limit`) off `q`
