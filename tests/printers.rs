@@ -122,28 +122,12 @@ fn the_wall_leaves_the_base_on_every_printer_it_fits() {
 /// `clayloft gcode` of shipped design `design` on shipped printer `profile` into `dir`: it
 /// prints, and `clayloft check` accepts the file. What the summary said.
 fn prints_and_checks(dir: &std::path::Path, design: &str, profile: &str) -> String {
-    let out = dir.join(format!("{design}.{profile}.gcode"));
-    let run = clayloft(&[
-        "gcode",
+    common::gcode_and_check(
         &format!("assets/designs/{design}.toml"),
-        "--printer",
-        profile,
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(
-        run.status.success(),
-        "{design} on {profile}: {}",
-        text(&run.stderr)
-    );
-    let check = clayloft(&["check", out.to_str().unwrap()]);
-    assert_eq!(
-        check.status.code(),
-        Some(0),
-        "{design} on {profile}: {}",
-        text(&check.stdout)
-    );
-    text(&run.stdout)
+        &["--printer", profile],
+        &dir.join(format!("{design}.{profile}.gcode")),
+        &format!("{design} on {profile}"),
+    )
 }
 
 /// The petal vase on the printers of the widest beads: where the belly pushes the wall out of

@@ -18,6 +18,25 @@ pub fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
+/// `clayloft gcode DESIGN [EXTRA…] -o OUT`: it prints, and `clayloft check OUT` (the limits of
+/// the file's header) accepts the file. What the summary said; `label` names the case in a
+/// failure.
+pub fn gcode_and_check(design: &str, extra: &[&str], out: &Path, label: &str) -> String {
+    let mut args = vec!["gcode", design];
+    args.extend_from_slice(extra);
+    args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+    let run = clayloft(&args);
+    assert!(run.status.success(), "{label}: {}", text(&run.stderr));
+    let check = clayloft(&["check", out.to_str().unwrap()]);
+    assert_eq!(
+        check.status.code(),
+        Some(0),
+        "{label}: {}",
+        text(&check.stdout)
+    );
+    text(&run.stdout)
+}
+
 /// The `.toml` files of a repository folder, sorted.
 pub fn toml_files(dir: &str) -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
