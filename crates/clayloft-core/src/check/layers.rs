@@ -1084,9 +1084,10 @@ struct Found {
     top_under: f64,
     top_chord: usize,
     /// The spot of least lean, as d / (p.z − zq) (the tangent of the lean, which is monotone in
-    /// it: one arctangent per point, not per spot).
+    /// it: one arctangent per point, not per spot), with d and zq: of spots leaning as little,
+    /// the highest.
     least_lean: Option<(f64, f64, f64)>,
-    /// The nearest spot in XY, (d, zq).
+    /// The nearest spot in XY, (d, zq): of spots as near, the highest.
     nearest: Option<(f64, f64)>,
 }
 
@@ -1102,11 +1103,19 @@ impl Found {
         if d <= half_bead && zq > self.top_under {
             (self.top_under, self.top_chord) = (zq, chord);
         }
+        // Ties go to the higher spot, so that the answer does not depend on the order the
+        // chords are met in (the grid meets them column by column, the tree box by box).
         let tan = d / (pz - zq).max(1e-9);
-        if self.least_lean.is_none_or(|(t, _, _)| tan < t) {
+        if self
+            .least_lean
+            .is_none_or(|(t, _, z)| tan < t || (tan == t && zq > z))
+        {
             self.least_lean = Some((tan, d, zq));
         }
-        if self.nearest.is_none_or(|(dn, _)| d < dn) {
+        if self
+            .nearest
+            .is_none_or(|(dn, z)| d < dn || (d == dn && zq > z))
+        {
             self.nearest = Some((d, zq));
         }
     }
@@ -1709,6 +1718,30 @@ mod tests {
     /// A flat spiral base from the centre out, then a wall that climbs, steps back down to
     /// print a second, lower ring inside the first (z falls along the path), and climbs again:
     /// chords that come back over earlier ones at every height order.
+    /// Spots as near in XY at different heights (a ring laid again over the same points, a
+    /// layer lower than the ring beside it: found by the proptest below): the grid meets the
+    /// chords column by column, the tree box by box, and every search takes the higher.
+    #[test]
+    fn spots_equally_near_are_taken_alike_by_every_search() {
+        let limits = Limits::from(&Printer::default());
+        let v = base_and_rings(
+            1.8457174072058156,
+            1.7088817164686907,
+            &[-0.0389837374335059, -0.3909880239543382],
+        );
+        let lines: Vec<usize> = (0..v.len()).collect();
+        let report = |search| {
+            let mut report = CheckReport::default();
+            measure_layers_in(&v, &lines, &limits, &mut report, search, false, None);
+            report
+        };
+        let every = report(Search::EveryChord);
+        assert!(!every.ok(), "the path breaks limits: {every}");
+        for search in [Search::NearFirst, Search::WholeBox, Search::Tree] {
+            assert_eq!(report(search), every, "{search:?}");
+        }
+    }
+
     fn base_and_rings(turns: f64, drop: f64, jitter: &[f64]) -> Vec<DVec3> {
         let mut v = Vec::new();
         let per_turn = 90.0;
