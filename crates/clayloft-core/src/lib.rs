@@ -47,6 +47,7 @@ pub mod profile;
 pub mod report;
 pub mod sample;
 pub mod save;
+pub mod seam;
 pub mod section;
 pub mod session;
 pub mod shape;

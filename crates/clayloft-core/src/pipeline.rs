@@ -182,6 +182,11 @@ pub fn finish_sections(
             |mm| format!("textured wall clamped by up to {mm:.2} mm at the overhang limit"),
         ));
     }
+    // A wall of several beads steps across where the layers are level (see `seam`).
+    if design.shape.walls > 1 {
+        let seam = crate::seam::flattest_sample(&sections, design.printer.line_width);
+        crate::seam::start_at(&mut sections, seam);
+    }
     let (metrics, point_leans_deg) = if keep_leans {
         measure_with_leans(&sections)
     } else {

@@ -141,6 +141,8 @@ pub struct SurfaceKey {
     pub bed: (BedShape, f64, f64, Origin),
     pub max_z: f64,
     pub center_given: bool,
+    /// A wall of several beads starts its sections at its seam ([`crate::seam`]).
+    pub several_beads: bool,
 }
 
 /// Inputs of the texture's displacement table: the texture and the section grid.
@@ -736,6 +738,7 @@ fn finish_stages(
         bed: (p.bed_shape, p.bed_x, p.bed_y, p.origin),
         max_z: p.max_z,
         center_given: design.shape.center.is_some(),
+        several_beads: design.shape.walls > 1,
     };
     let disp = design
         .texture
@@ -1140,8 +1143,22 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
                 ..Update::default()
             }
         );
-        // Two beads: the beads and the toolpath, not the surface.
+        // Two beads: the surface (it starts at the beads' seam, see `seam`), the beads and the
+        // toolpath; a third bead, not the surface.
         e.shape.walls = 2;
+        let u = s.update(&e).unwrap();
+        assert_eq!(
+            u,
+            Update {
+                surface: true,
+                beads: true,
+                toolpath: true,
+                verdict: true,
+                ..Update::default()
+            }
+        );
+        assert_eq!(s.beads().unwrap().len(), 1);
+        e.shape.walls = 3;
         let u = s.update(&e).unwrap();
         assert_eq!(
             u,
@@ -1152,7 +1169,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
                 ..Update::default()
             }
         );
-        assert_eq!(s.beads().unwrap().len(), 1);
+        assert_eq!(s.beads().unwrap().len(), 2);
         e.shape.walls = 1;
         s.update(&e).unwrap();
         assert!(s.beads().unwrap().is_empty());
@@ -1184,11 +1201,17 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         // The limit the colours mark: a new mesh (and a corrected surface).
         e.printer.max_overhang_deg = 40.0;
         assert!(s.update(&e).unwrap().wall_view);
-        // A second bead: the mesh shows its inner sheet.
+        // A second bead: the mesh shows its inner sheet (the surface is made again, started at
+        // the beads' seam); a third, with the same surface.
         e.shape.walls = 2;
         let u = s.update(&e).unwrap();
+        assert!(u.wall_view && u.surface);
+        let two = s.wall_view().unwrap().positions.len();
+        assert!(two > first.positions.len());
+        e.shape.walls = 3;
+        let u = s.update(&e).unwrap();
         assert!(u.wall_view && !u.surface);
-        assert!(s.wall_view().unwrap().positions.len() > first.positions.len());
+        assert_eq!(s.wall_view().unwrap().positions.len(), two);
     }
 
     #[test]
