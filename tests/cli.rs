@@ -130,6 +130,32 @@ fn every_shipped_design_prints_with_two_beads_on_one_base_layer() {
     }
 }
 
+/// Every shipped design but the woven one prints with two and with three beads on three base
+/// layers and passes `check`. The flared bowl (its foot flares 0.7 mm a layer, clamped to 45°)
+/// was refused with two beads, 351 points a layer too thick: the top base layer's ring a bead
+/// in was the first layer's, 1.4 mm inside its outline, and the wall's inner bead crossed the
+/// gap. Each base layer now lays that ring inside its own outline. The woven texture swings
+/// the foot 4 mm from layer to layer, so neither the first foot's rings nor each layer's own
+/// carry a second bead on it (refused, with the overhang of the base's own rings).
+#[test]
+fn every_shipped_design_but_the_woven_prints_with_several_beads_on_three_base_layers() {
+    let dir = tempfile::tempdir().unwrap();
+    for d in designs() {
+        let name = d.file_stem().unwrap().to_str().unwrap();
+        for walls in [2, 3] {
+            // Three beads rise too little a turn on the ellipse's layers (refused by the
+            // validator, saying so).
+            if name == "paper-woven" || (name == "ellipse-ripple" && walls == 3) {
+                continue;
+            }
+            let design = with_beads(dir.path(), &d, walls, 3);
+            let gcode = dir.path().join(format!("{name}-{walls}.gcode"));
+            let label = format!("{name} with {walls} beads on 3 base layers");
+            gcode_and_check(design.to_str().unwrap(), &[], &gcode, &label);
+        }
+    }
+}
+
 /// The tilted rim with two and three beads, on no base and on three layers: its top slopes
 /// across the contours' start (0°), where the next turn passed over the step between the beads
 /// 0.24 mm above it (41 points too thin, for 0.25 mm). The beads now step across on its low

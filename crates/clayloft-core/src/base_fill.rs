@@ -27,6 +27,13 @@
 //!
 //! The layer starts and ends at the foot's point 0, so base layers stack without a travel move
 //! (alternate layers run the same path backwards) and the last ends where the wall begins.
+//!
+//! **Several layers.** Each base layer's outline is its own foot (a flaring wall's feet grow a
+//! layer's height times the lean from layer to layer); the rings inside are the first foot's on
+//! every layer, so that they and their bridges stack. Under a wall of W beads on a foot that
+//! moves more than a quarter bead over the base, the W − 1 rings its inner beads rest on follow
+//! each layer's own foot instead (each moves as the outline does, within the overhang limit), and
+//! the first foot's rings go on further in.
 
 use cavalier_contours::polyline::{PlineCreation, PlineSource, PlineSourceMut, Polyline};
 use glam::DVec2;
@@ -670,6 +677,154 @@ fn bridges(node: &Node, start: f64, span: f64, w: f64, late: bool) -> Vec<(Bridg
     out
 }
 
+/// Where a ring's children are entered ([`bridges`]), and, as far as planned, where theirs
+/// are (by child): chosen once on the first base layer's rings so that every layer's bridges
+/// stack.
+#[derive(Debug, Clone, Default)]
+struct Entries {
+    here: Vec<(Bridge, usize)>,
+    below: Vec<Option<Entries>>,
+}
+
+/// The bridges of `node`'s walk from `start` over `span` ([`bridges`]; `late` on the outline),
+/// and those of its children's walks `depth` levels further down, as [`walk_node`] walks them
+/// under `whole_levels` rings laid all round.
+fn plan_entries(
+    node: &Node,
+    start: f64,
+    span: f64,
+    w: f64,
+    late: bool,
+    depth: usize,
+    whole_levels: usize,
+) -> Entries {
+    let here = bridges(node, start, span, w, late);
+    let mut below = vec![None; node.children.len()];
+    if depth > 0 {
+        for &(bridge, c) in &here {
+            let child = &node.children[c];
+            let clen = child.ring.len();
+            let gap = if whole_levels > 0 {
+                OUTLINE_BRIDGE_GAP_BEADS
+            } else {
+                BRIDGE_GAP_BEADS
+            };
+            let child_span = if whole_levels > 1 {
+                clen
+            } else {
+                clen - (gap * w).min(0.5 * clen)
+            };
+            below[c] = Some(plan_entries(
+                child,
+                bridge.child_entry,
+                child_span,
+                w,
+                false,
+                depth - 1,
+                whole_levels.saturating_sub(1),
+            ));
+        }
+    }
+    Entries { here, below }
+}
+
+/// `entries` (planned on `old`'s rings) for `new`, whose rings `depth` levels down are its own
+/// (the rest `old`'s): each entry on a ring of its own moved to the point of that ring nearest
+/// the planned one.
+fn remap_entries(entries: &Entries, old: &Node, new: &Node, depth: usize) -> Entries {
+    let here = entries
+        .here
+        .iter()
+        .map(|&(b, c)| {
+            let entry = if depth > 0 {
+                new.children[c]
+                    .ring
+                    .nearest(old.children[c].ring.at(b.child_entry))
+                    .0
+            } else {
+                b.child_entry
+            };
+            (
+                Bridge {
+                    child_entry: entry,
+                    ..b
+                },
+                c,
+            )
+        })
+        .collect();
+    let below = entries
+        .below
+        .iter()
+        .enumerate()
+        .map(|(c, e)| {
+            let e = e.as_ref()?;
+            Some(if depth > 1 {
+                remap_entries(e, &old.children[c], &new.children[c], depth - 1)
+            } else {
+                e.clone()
+            })
+        })
+        .collect();
+    Entries { here, below }
+}
+
+/// The children of a ring whose own outline is now `exact` (a base layer's foot): `old`'s
+/// children with each ring a bead in replaced by the same ring of `exact`'s offset, and so on
+/// `levels` deep (below that, `old`'s rings, and `old`'s middle rings throughout). `None` where
+/// the offsets do not pair one to one with `old`'s rings (a waist the layer's foot splits at
+/// differently).
+fn own_children(
+    old: &Node,
+    exact: &Polyline<f64>,
+    w: f64,
+    levels: usize,
+    anticlockwise: bool,
+) -> Option<Vec<Node>> {
+    let own = offset_exact(exact, w).ok()?;
+    let olds: Vec<usize> = (0..old.children.len())
+        .filter(|&c| old.children[c].step == w)
+        .collect();
+    if own.len() != olds.len() {
+        return None;
+    }
+    let centre = |pts: &[DVec2]| pts.iter().copied().sum::<DVec2>() / pts.len().max(1) as f64;
+    let mut children = old.children.clone();
+    let mut used = vec![false; own.len()];
+    for &c in &olds {
+        let at = centre(&old.children[c].ring.pts);
+        let k = (0..own.len()).filter(|&k| !used[k]).min_by(|&a, &b| {
+            centre(&own[a].1)
+                .distance(at)
+                .total_cmp(&centre(&own[b].1).distance(at))
+        })?;
+        used[k] = true;
+        let (inner, mut pts) = own[k].clone();
+        // Each ring runs opposite to the ring around it (see [`orient`]).
+        if (crate::geometry::signed_area(&pts) > 0.0) == anticlockwise {
+            pts.reverse();
+            pts.rotate_right(1);
+        }
+        let mut ring = Ring::new(pts);
+        ring.spurs = corner_spurs(&ring, !anticlockwise, w, w);
+        let grandchildren = if levels > 1 {
+            own_children(&old.children[c], &inner, w, levels - 1, !anticlockwise)?
+        } else {
+            old.children[c].children.clone()
+        };
+        children[c] = Node {
+            ring,
+            step: w,
+            children: grandchildren,
+        };
+    }
+    Some(children)
+}
+
+/// How far, in beads, a base layer's foot may lie from the first's before the rings under the
+/// wall's inner beads follow each layer's own foot (see [`fill_feet_then`]).
+const OWN_RINGS_DRIFT_BEADS: f64 = 0.25;
+
 /// Walks `node` from arc length `start` for `span`, visiting its children by their bridges
 /// (`entries`: where to enter each child, if already chosen). While `whole_levels > 0`, each
 /// bridge steps back out to where it stepped in, so that the ring is laid all round: the
@@ -682,7 +837,7 @@ fn walk_node(
     start: f64,
     span: f64,
     w: f64,
-    entries: Option<&[(Bridge, usize)]>,
+    entries: Option<&Entries>,
     whole_levels: usize,
     out: &mut Vec<DVec2>,
 ) {
@@ -691,6 +846,7 @@ fn walk_node(
     let mut at = 0.0;
     let placed = match entries {
         Some(e) => e
+            .here
             .iter()
             .filter_map(|(b, c)| {
                 bridge_at(&node.ring, &node.children[*c].ring, start, b.child_entry, w)
@@ -724,7 +880,7 @@ fn walk_node(
             bridge.child_entry,
             child_span,
             w,
-            None,
+            entries.and_then(|e| e.below.get(c)?.as_ref()),
             whole_levels.saturating_sub(1),
             out,
         );
@@ -783,7 +939,8 @@ pub fn fill_foot(foot: &[DVec2], w: f64) -> Result<BaseFill, FillError> {
 
 /// The paths of several base layers, one per foot (bottom up): the rings inside are those of the
 /// first foot on every layer, so that each layer's beads lie on the beads below; only the
-/// outline (and the bridge from it) follows each layer's own foot.
+/// outline (and the bridge from it) follows each layer's own foot (and, under a wall of several
+/// beads, the rings under its inner beads: see [`fill_feet_then`]).
 pub fn fill_feet(feet: &[Vec<DVec2>], w: f64) -> Result<Vec<BaseFill>, FillError> {
     fill_feet_then(feet, w, 1, || ())
 }
@@ -829,16 +986,51 @@ pub fn fill_feet_then(
         step: 0.0,
         children: inner.children.clone(),
     };
-    let entries = bridges(&first_root, 0.0, first_root.ring.len(), w, true);
+    // Under a wall of several beads on a foot that flares (or draws in) over the base, the rings
+    // its inner beads rest on follow each layer's own foot: the first foot's lay up to a bead
+    // inside the top layer's outline, and the first revolution's inner bead crossed the gap
+    // (random designs; the flared bowl with two beads on three base layers: 351 points a layer
+    // too thick). A layer's own ring moves from the one below as its outline does, by at most
+    // the overhang limit; the rings further in are the first foot's on every layer.
+    let levels = walls.max(1) - 1;
+    let drifts = levels > 0
+        && feet[1..].iter().any(|foot| {
+            foot.iter()
+                .any(|&p| first_root.ring.nearest(p).1 > OWN_RINGS_DRIFT_BEADS * w)
+        });
+    let own_levels = if drifts { levels } else { 0 };
+    let entries = plan_entries(
+        &first_root,
+        0.0,
+        first_root.ring.len(),
+        w,
+        true,
+        own_levels,
+        walls.max(1),
+    );
     // Each layer's walk (0.3 ms for the benchmark vase's foot), one layer per core.
     Ok(crate::parallel::map_ranges(feet.len(), 2, |layers| {
-        feet[layers]
-            .iter()
-            .map(|foot| {
-                let root = Node {
+        layers
+            .map(|m| {
+                let foot = &feet[m];
+                let own = (own_levels > 0 && m > 0)
+                    .then(|| own_children(&first_root, &polyline(foot), w, own_levels, true))
+                    .flatten();
+                let mut root = Node {
                     ring: Ring::new(foot.clone()),
                     step: 0.0,
-                    children: inner.children.clone(),
+                    children: Vec::new(),
+                };
+                let plan = match own {
+                    Some(children) => {
+                        root.children = children;
+                        prune_spurs(&mut root);
+                        remap_entries(&entries, &first_root, &root, own_levels)
+                    }
+                    None => {
+                        root.children = inner.children.clone();
+                        entries.clone()
+                    }
                 };
                 let mut path = Vec::new();
                 walk_node(
@@ -846,7 +1038,7 @@ pub fn fill_feet_then(
                     0.0,
                     root.ring.len(),
                     w,
-                    Some(&entries),
+                    Some(&plan),
                     walls.max(1),
                     &mut path,
                 );
@@ -1143,6 +1335,57 @@ mod tests {
         // One bead: the ring's gap is a bead long, its middle half a bead from the steps.
         let gap = farthest(&fill(1)[0].path);
         assert!(gap > 0.3 * W, "{gap}");
+    }
+
+    /// Under a wall of two beads on a star foot that flares 0.3 bead a layer over three base
+    /// layers, each layer lays the ring a bead inside its own outline all round (where the
+    /// wall's inner bead will rest), not the first foot's, which lies 0.6 bead further in on the
+    /// top layer; the rings further in are the first foot's on every layer, so they stack. Under
+    /// one bead, or on a foot that does not move, every layer's rings are the first foot's.
+    #[test]
+    fn under_two_beads_the_ring_a_bead_in_follows_each_layer_s_foot() {
+        let feet: Vec<Vec<DVec2>> = (0..3)
+            .map(|m| six_point_star(30.0 + 0.3 * W * m as f64, 360))
+            .collect();
+        // How far the points of `ring` (resampled every 0.06 bead) lie from `path` at most.
+        let farthest = |ring: &[DVec2], path: &[DVec2]| {
+            crate::geometry::resample_closed(ring, 4000)
+                .iter()
+                .map(|&q| {
+                    path.windows(2)
+                        .map(|s| crate::geometry::point_segment_distance(q, s[0], s[1]).0)
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .fold(0.0, f64::max)
+        };
+        let a_bead_in = |foot: &[DVec2]| inward_offset(foot, W).expect("a ring a bead in");
+        let two_in = inward_offset(&feet[0], 2.0 * W).expect("a ring two beads in");
+        let two = fill_feet_then(&feet, W, 2, || ()).unwrap();
+        for (m, layer) in two.iter().enumerate() {
+            let own = farthest(&a_bead_in(&feet[m]), &layer.path);
+            assert!(
+                own < 0.01 * W,
+                "layer {m}: its own ring {own} mm from the path"
+            );
+            let deeper = farthest(&two_in, &layer.path);
+            // (Left open for half a bead where its bridge leaves it.)
+            assert!(
+                deeper < 0.5 * W,
+                "layer {m}: the ring two in {deeper} mm off"
+            );
+        }
+        let first = farthest(&a_bead_in(&feet[0]), &two[2].path);
+        assert!(
+            first > 0.3 * W,
+            "the first foot's ring is laid on the top layer: {first}"
+        );
+        for layers in [
+            fill_feet_then(&feet, W, 1, || ()).unwrap(),
+            fill_feet_then(&vec![feet[0].clone(); 3], W, 2, || ()).unwrap(),
+        ] {
+            let first = farthest(&a_bead_in(&feet[0]), &layers[2].path);
+            assert!(first < 0.6 * W, "{first}");
+        }
     }
 
     #[test]
