@@ -992,12 +992,26 @@ pub fn fill_feet_then(
     // (random designs; the flared bowl with two beads on three base layers: 351 points a layer
     // too thick). A layer's own ring moves from the one below as its outline does, by at most
     // the overhang limit; the rings further in are the first foot's on every layer.
+    // Only where the feet grow: where one draws in by half a bead, its own rings would crowd
+    // the first foot's further in (the first foot's rings then carry the beads anyway).
     let levels = walls.max(1) - 1;
-    let drifts = levels > 0
-        && feet[1..].iter().any(|foot| {
-            foot.iter()
-                .any(|&p| first_root.ring.nearest(p).1 > OWN_RINGS_DRIFT_BEADS * w)
-        });
+    let drifts = levels > 0 && {
+        let drift = |p: DVec2| {
+            let d = first_root.ring.nearest(p).1;
+            if d > 0.5 * w && crate::geometry::contains_point(first, p) {
+                -d
+            } else {
+                d
+            }
+        };
+        let (mut out, mut inward) = (false, false);
+        for &p in feet[1..].iter().flatten() {
+            let d = drift(p);
+            out |= d > OWN_RINGS_DRIFT_BEADS * w;
+            inward |= d < -0.5 * w;
+        }
+        out && !inward
+    };
     let own_levels = if drifts { levels } else { 0 };
     let entries = plan_entries(
         &first_root,
@@ -1341,7 +1355,8 @@ mod tests {
     /// layers, each layer lays the ring a bead inside its own outline all round (where the
     /// wall's inner bead will rest), not the first foot's, which lies 0.6 bead further in on the
     /// top layer; the rings further in are the first foot's on every layer, so they stack. Under
-    /// one bead, or on a foot that does not move, every layer's rings are the first foot's.
+    /// one bead, or on a foot that does not move or draws in, every layer's rings are the first
+    /// foot's.
     #[test]
     fn under_two_beads_the_ring_a_bead_in_follows_each_layer_s_foot() {
         let feet: Vec<Vec<DVec2>> = (0..3)
@@ -1379,9 +1394,15 @@ mod tests {
             first > 0.3 * W,
             "the first foot's ring is laid on the top layer: {first}"
         );
+        // A foot drawing in (0.3 bead a layer: the first foot's ring a bead in still carries
+        // the inner bead) keeps the first foot's rings too.
+        let drawing_in: Vec<Vec<DVec2>> = (0..3)
+            .map(|m| six_point_star(30.0 - 0.3 * W * m as f64, 360))
+            .collect();
         for layers in [
             fill_feet_then(&feet, W, 1, || ()).unwrap(),
             fill_feet_then(&vec![feet[0].clone(); 3], W, 2, || ()).unwrap(),
+            fill_feet_then(&drawing_in, W, 2, || ()).unwrap(),
         ] {
             let first = farthest(&a_bead_in(&feet[0]), &layers[2].path);
             assert!(first < 0.6 * W, "{first}");
