@@ -9,8 +9,8 @@
 //! thinner than the printer lays (the tilted rim with two beads: 0.236 mm for 0.25 mm, at 41
 //! points). A seam where every layer is level across half a bead either side has none of that.
 //!
-//! [`flattest_sample`] finds that sample: the one whose neighbours within half a bead (and a
-//! half more, for the turns' own rise) lie least below it on any layer that slopes — a valley
+//! [`flattest_sample`] finds that sample: the one that the ring within half a bead either side
+//! lies least below on any layer that slopes — a valley
 //! of the layers, where they all lie higher and the turns pass over the step with more than
 //! Δ/W, else where the layers are most level. On walls whose layers are all planar it is
 //! sample 0, where the contours start: the seam moves only where it must.
@@ -21,12 +21,19 @@ use crate::section::Section;
 /// sample nearer the contours' start is kept.
 const AS_FLAT_MM: f64 = 1e-6;
 
+/// How far either side of the seam the next turn passes over its step, in beads: a point on the
+/// turn lies as far from the step as it lies along the ring from the seam, and rests on the
+/// step within half a bead (a tenth more for the turns' own curve).
+const SEAM_WINDOW_BEADS: f64 = 0.55;
+
 /// The sample at which a wall of beads `w` wide on `sections` (all of one length) is best
-/// stepped across: the first of those that the samples within 0.75·`w` along the section (at
-/// least one either side) lie least below, on the sections that are not planar. 0 where sample
-/// 0 is as good as any, where every section is planar, and for sections of fewer than 3
-/// points.
-pub fn flattest_sample(sections: &[Section], w: f64) -> usize {
+/// stepped across: the first of those that the ring within 0.55·`w` either side lies least
+/// below, on the sections that are not planar. 0 where the
+/// samples lie at most `room` mm below sample 0 (the turns pass over its step a layer thick
+/// enough: Δ/W less the minimum layer), where sample 0 is as good as any, where every section
+/// is planar, and for sections of fewer than 3 points: a seam moved changes where each
+/// revolution blends from section to section, and with it the lean where the layers bunch.
+pub fn flattest_sample(sections: &[Section], w: f64, room: f64) -> usize {
     let n = sections.first().map_or(0, |s| s.points.len());
     if n < 3 || sections.iter().any(|s| s.points.len() != n) {
         return 0;
@@ -47,49 +54,44 @@ pub fn flattest_sample(sections: &[Section], w: f64) -> usize {
     if sloped.is_empty() {
         return 0;
     }
-    let reach = neighbours_within(&sloped, 0.75 * w).clamp(1, n / 4).max(1);
-    // score[j]: how far any sample within reach lies below sample j, on the sloped sections
-    // (negative in a valley, where all of them lie higher).
+    // score[j]: how far the ring lies below sample j within SEAM_WINDOW_BEADS·w of it either
+    // way along the ring (interpolated along the segment that leaves the window), on the
+    // sloped sections: negative in a valley, where it lies higher all round.
+    let window = SEAM_WINDOW_BEADS * w;
     let mut score = vec![f64::NEG_INFINITY; n];
     for s in &sloped {
-        let z = |i: usize| s.points[i % n].z;
+        let p = |i: usize| s.points[i % n];
         for (j, worst) in score.iter_mut().enumerate() {
-            let here = z(j);
-            for i in 1..=reach {
-                let drop = (here - z(j + i)).max(here - z(j + n - i));
-                *worst = worst.max(drop);
+            let here = p(j);
+            for forward in [true, false] {
+                let next = |i: usize| if forward { i + 1 } else { i + n - 1 };
+                let (mut at, mut walked) = (j + n, 0.0);
+                for _ in 0..n / 2 {
+                    let to = next(at);
+                    let step = p(at).truncate().distance(p(to).truncate());
+                    let z = if walked + step >= window && step > 0.0 {
+                        p(at).z + (p(to).z - p(at).z) * ((window - walked) / step)
+                    } else {
+                        p(to).z
+                    };
+                    *worst = worst.max(here.z - z);
+                    walked += step;
+                    at = to;
+                    if walked >= window {
+                        break;
+                    }
+                }
             }
         }
     }
     let least = score.iter().copied().fold(f64::INFINITY, f64::min);
-    if !least.is_finite() || score[0] <= least + AS_FLAT_MM {
+    if !least.is_finite() || score[0] <= room || score[0] <= least + AS_FLAT_MM {
         return 0;
     }
     score
         .iter()
         .position(|&s| s <= least + AS_FLAT_MM)
         .unwrap_or(0)
-}
-
-/// How many samples lie within `reach` mm along the sections on average: `reach` over the
-/// mean spacing of their points (rounded up).
-fn neighbours_within(sections: &[&Section], reach: f64) -> usize {
-    let (mut length, mut count) = (0.0, 0usize);
-    for s in sections {
-        let n = s.points.len();
-        for i in 0..n {
-            length += s.points[i]
-                .truncate()
-                .distance(s.points[(i + 1) % n].truncate());
-        }
-        count += n;
-    }
-    let spacing = length / count.max(1) as f64;
-    if spacing > 0.0 && (reach / spacing).is_finite() {
-        (reach / spacing).ceil().min(1e9) as usize
-    } else {
-        1
-    }
 }
 
 /// Rotates every section to start at sample `seam` (before anything is measured per point).
@@ -131,18 +133,19 @@ mod tests {
 
     #[test]
     fn level_layers_keep_the_seam_where_the_contours_start() {
-        assert_eq!(flattest_sample(&rings(180, 40, 0, |_| 0.0), 3.0), 0);
-        assert_eq!(flattest_sample(&[], 3.0), 0);
+        assert_eq!(flattest_sample(&rings(180, 40, 0, |_| 0.0), 3.0, 0.0), 0);
+        assert_eq!(flattest_sample(&[], 3.0, 0.0), 0);
     }
 
     #[test]
     fn a_tilted_top_moves_the_seam_to_its_lowest_side() {
         // Sine tilt, highest at 90° and lowest at 270° (sample 135 of 180).
         let sections = rings(180, 60, 20, |a| 10.0 * a.sin());
-        assert_eq!(flattest_sample(&sections, 3.0), 135);
-        // A tilt whose valley is at the contours' start keeps it there.
+        assert_eq!(flattest_sample(&sections, 3.0, 0.0), 135);
+        // A tilt whose valley is at the contours' start keeps it there (searched for however
+        // little room there is).
         let sections = rings(180, 60, 20, |a| -10.0 * a.cos());
-        assert_eq!(flattest_sample(&sections, 3.0), 0);
+        assert_eq!(flattest_sample(&sections, 3.0, -1.0), 0);
         // Two peaks and two valleys, straight between them (a control line's corners): the
         // first valley, though the lower peak is flatter across.
         let zigzag = |a: f64| {
@@ -151,7 +154,16 @@ mod tests {
             up * (1.0 - ((t % 2.0) - 1.0).abs())
         };
         let sections = rings(60, 30, 10, zigzag);
-        assert_eq!(flattest_sample(&sections, 3.0), 0);
+        assert_eq!(flattest_sample(&sections, 3.0, -1.0), 0);
+    }
+
+    #[test]
+    fn a_seam_with_room_for_its_slope_stays_where_the_contours_start() {
+        // Half a bead and a tenth (1.65 mm, 2.7° on a 35 mm ring) before 0°, the top ring lies
+        // 10·sin 2.7° ≈ 0.47 mm below it.
+        let sections = rings(180, 60, 20, |a| 10.0 * a.sin());
+        assert_eq!(flattest_sample(&sections, 3.0, 0.4), 135);
+        assert_eq!(flattest_sample(&sections, 3.0, 0.5), 0);
     }
 
     #[test]
