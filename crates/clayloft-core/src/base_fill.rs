@@ -703,21 +703,10 @@ fn plan_entries(
     if depth > 0 {
         for &(bridge, c) in &here {
             let child = &node.children[c];
-            let clen = child.ring.len();
-            let gap = if whole_levels > 0 {
-                OUTLINE_BRIDGE_GAP_BEADS
-            } else {
-                BRIDGE_GAP_BEADS
-            };
-            let child_span = if whole_levels > 1 {
-                clen
-            } else {
-                clen - (gap * w).min(0.5 * clen)
-            };
             below[c] = Some(plan_entries(
                 child,
                 bridge.child_entry,
-                child_span,
+                child_span(&child.ring, w, whole_levels),
                 w,
                 false,
                 depth - 1,
@@ -825,6 +814,25 @@ fn own_children(
 /// wall's inner beads follow each layer's own foot (see [`fill_feet_then`]).
 const OWN_RINGS_DRIFT_BEADS: f64 = 0.25;
 
+/// How much of `child` the walk of its parent lays (in arc length from its entry), the parent
+/// under `whole_levels` rings laid all round: all of it where the child is laid all round too (a
+/// ring under a bead of the wall is walked all the way round, back through the point it was
+/// entered at, and half a bead on, so that the step back out does not run back down the step
+/// in); else all but the gap its bridge leaves, a bead from the outline, half a bead inside.
+fn child_span(child: &Ring, w: f64, whole_levels: usize) -> f64 {
+    let clen = child.len();
+    let gap = if whole_levels > 0 {
+        OUTLINE_BRIDGE_GAP_BEADS
+    } else {
+        BRIDGE_GAP_BEADS
+    };
+    if whole_levels > 1 {
+        clen
+    } else {
+        clen - (gap * w).min(0.5 * clen)
+    }
+}
+
 /// Walks `node` from arc length `start` for `span`, visiting its children by their bridges
 /// (`entries`: where to enter each child, if already chosen). While `whole_levels > 0`, each
 /// bridge steps back out to where it stepped in, so that the ring is laid all round: the
@@ -862,23 +870,10 @@ fn walk_node(
         node.ring.walk(start + at, start + bridge.s_in, out);
         let child = &node.children[c];
         let clen = child.ring.len();
-        let gap = if whole {
-            OUTLINE_BRIDGE_GAP_BEADS
-        } else {
-            BRIDGE_GAP_BEADS
-        };
-        // A ring under a bead of the wall is walked all the way round, back through the
-        // point it was entered at, and half a bead on, so that the step back out does not
-        // run back down the step in.
-        let child_span = if whole_levels > 1 {
-            clen
-        } else {
-            clen - (gap * w).min(0.5 * clen)
-        };
         walk_node(
             child,
             bridge.child_entry,
-            child_span,
+            child_span(&child.ring, w, whole_levels),
             w,
             entries.and_then(|e| e.below.get(c)?.as_ref()),
             whole_levels.saturating_sub(1),
