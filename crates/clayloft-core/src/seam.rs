@@ -9,11 +9,13 @@
 //! thinner than the printer lays (the tilted rim with two beads: 0.236 mm for 0.25 mm, at 41
 //! points). A seam where every layer is level across half a bead either side has none of that.
 //!
-//! [`flattest_sample`] finds that sample: the one that the ring within half a bead either side
-//! lies least below on any layer that slopes — a valley
-//! of the layers, where they all lie higher and the turns pass over the step with more than
-//! Δ/W, else where the layers are most level. On walls whose layers are all planar it is
-//! sample 0, where the contours start: the seam moves only where it must.
+//! [`flattest_sample`] finds that sample where sample 0 lacks the room: the one that the ring
+//! within half a bead either side lies least below on any layer that slopes — a valley of the
+//! layers, where they all lie higher and the turns pass over the step with more than Δ/W, else
+//! where the layers are most level. On walls whose layers are all planar, or that leave the
+//! turns room over a step at sample 0, it is sample 0, where the contours start: the seam
+//! moves only where it must (a seam moved also moves where each revolution blends from one
+//! section to the next, which changes the lean where the layers bunch up).
 
 use crate::section::Section;
 
@@ -28,11 +30,10 @@ const SEAM_WINDOW_BEADS: f64 = 0.55;
 
 /// The sample at which a wall of beads `w` wide on `sections` (all of one length) is best
 /// stepped across: the first of those that the ring within 0.55·`w` either side lies least
-/// below, on the sections that are not planar. 0 where the
-/// samples lie at most `room` mm below sample 0 (the turns pass over its step a layer thick
-/// enough: Δ/W less the minimum layer), where sample 0 is as good as any, where every section
-/// is planar, and for sections of fewer than 3 points: a seam moved changes where each
-/// revolution blends from section to section, and with it the lean where the layers bunch.
+/// below, on the sections that are not planar. 0 where the ring there lies at most `room` mm
+/// below sample 0 (the turns pass over its step a layer thick enough: Δ/W less the minimum
+/// layer), where sample 0 is as good as any, where every section is planar, and for sections
+/// of fewer than 3 points.
 pub fn flattest_sample(sections: &[Section], w: f64, room: f64) -> usize {
     let n = sections.first().map_or(0, |s| s.points.len());
     if n < 3 || sections.iter().any(|s| s.points.len() != n) {
