@@ -834,7 +834,8 @@ fn child_span(child: &Ring, w: f64, whole_levels: usize) -> f64 {
 }
 
 /// Walks `node` from arc length `start` for `span`, visiting its children by their bridges
-/// (`entries`: where to enter each child, if already chosen). While `whole_levels > 0`, each
+/// (`entries`: where to enter each child, and as far as planned each child's children, if
+/// already chosen; else chosen here, level by level). While `whole_levels > 0`, each
 /// bridge steps back out to where it stepped in, so that the ring is laid all round: the
 /// outline's, on which the wall's first revolution (or the next base layer's outline, a
 /// layer's height out on a wall flaring at 45°) rests, and the rings in under a wall's inner
