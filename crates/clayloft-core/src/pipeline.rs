@@ -184,8 +184,12 @@ pub fn finish_sections(
     }
     // A wall of several beads steps across where the layers are level (see `seam`).
     if design.shape.walls > 1 {
-        let room = grid.layer_pitch / design.shape.walls as f64 - design.printer.min_layer_height;
-        let seam = crate::seam::flattest_sample(&sections, design.printer.line_width, room);
+        let seam = crate::seam::flattest_sample(
+            &sections,
+            design.printer.line_width,
+            design.shape.walls,
+            design.printer.min_layer_height,
+        );
         crate::seam::start_at(&mut sections, seam);
     }
     let (metrics, point_leans_deg) = if keep_leans {

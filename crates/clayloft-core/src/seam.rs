@@ -9,13 +9,14 @@
 //! thinner than the printer lays (the tilted rim with two beads: 0.236 mm for 0.25 mm, at 41
 //! points). A seam where every layer is level across half a bead either side has none of that.
 //!
-//! [`flattest_sample`] finds that sample where sample 0 lacks the room: the one that the ring
-//! within half a bead either side lies least below on any layer that slopes — a valley of the
-//! layers, where they all lie higher and the turns pass over the step with more than Δ/W, else
-//! where the layers are most level. On walls whose layers are all planar, or that leave the
-//! turns room over a step at sample 0, it is sample 0, where the contours start: the seam
-//! moves only where it must (a seam moved also moves where each revolution blends from one
-//! section to the next, which changes the lean where the layers bunch up).
+//! [`flattest_sample`] finds that sample where sample 0 lacks the room: the one where the
+//! turns pass over the step most thickly on every layer that slopes — a valley of the layers,
+//! where they all lie higher and the turns pass over the step with more than Δ/W, else where
+//! the layers are most level or thickest. On walls whose layers are all planar, or that leave
+//! the turns a minimum layer over a step at sample 0 on every layer, it is sample 0, where the
+//! contours start: the seam moves only where it must (a seam moved also moves where each
+//! revolution blends from one section to the next, which changes the lean where the layers
+//! bunch up).
 
 use crate::section::Section;
 
@@ -28,42 +29,46 @@ const AS_FLAT_MM: f64 = 1e-6;
 /// step within half a bead (a tenth more for the turns' own curve).
 const SEAM_WINDOW_BEADS: f64 = 0.55;
 
-/// The sample at which a wall of beads `w` wide on `sections` (all of one length) is best
-/// stepped across: the first of those that the ring within 0.55·`w` either side lies least
-/// below, on the sections that are not planar. 0 where the ring there lies at most `room` mm
-/// below sample 0 (the turns pass over its step a layer thick enough: Δ/W less the minimum
-/// layer), where sample 0 is as good as any, where every section is planar, and for sections
-/// of fewer than 3 points.
-pub fn flattest_sample(sections: &[Section], w: f64, room: f64) -> usize {
+/// The sample at which a wall of `walls` beads `w` wide on `sections` (all of one length) is
+/// best stepped across. A step at sample j is laid on each revolution's section k at its
+/// height; the next turn passes within 0.55·`w` of it either side up to the drop of the ring
+/// there below it, Δ/W higher (Δ the layer at j, from section k − 1 to k): that is the layer
+/// over the step, which must be at least `min_layer`. Sample 0, where the contours start, where
+/// every section keeps that (or every section is planar, or the sections have fewer than 3
+/// points); else the first of the samples where the worst shortfall over the sections that are
+/// not planar is least.
+pub fn flattest_sample(sections: &[Section], w: f64, walls: usize, min_layer: f64) -> usize {
     let n = sections.first().map_or(0, |s| s.points.len());
     if n < 3 || sections.iter().any(|s| s.points.len() != n) {
         return 0;
     }
-    // Only sections that are not level anywhere count; planar ones score 0 at every sample.
-    let sloped: Vec<&Section> = sections
-        .iter()
-        .filter(|s| {
-            let (lo, hi) = s
-                .points
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                    (lo.min(p.z), hi.max(p.z))
-                });
-            hi - lo > AS_FLAT_MM
-        })
-        .collect();
-    if sloped.is_empty() {
-        return 0;
-    }
-    // score[j]: how far the ring lies below sample j within SEAM_WINDOW_BEADS·w of it either
-    // way along the ring (interpolated along the segment that leaves the window), on the
-    // sloped sections: negative in a valley, where it lies higher all round.
+    let level = |s: &Section| {
+        let (lo, hi) = s
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.z), hi.max(p.z))
+            });
+        hi - lo <= AS_FLAT_MM
+    };
     let window = SEAM_WINDOW_BEADS * w;
+    let share = 1.0 / walls.max(1) as f64;
+    // score[j]: how much thinner than the minimum layer the turns pass over a step at j, at
+    // worst over the sections that are not planar (negative: room to spare).
     let mut score = vec![f64::NEG_INFINITY; n];
-    for s in &sloped {
+    let mut any = false;
+    for k in 1..sections.len() {
+        let s = &sections[k];
+        if level(s) {
+            continue;
+        }
+        any = true;
+        let below = &sections[k - 1];
         let p = |i: usize| s.points[i % n];
         for (j, worst) in score.iter_mut().enumerate() {
             let here = p(j);
+            let room = (here.z - below.points[j].z) * share - min_layer;
+            let mut drop = f64::NEG_INFINITY;
             for forward in [true, false] {
                 let next = |i: usize| if forward { i + 1 } else { i + n - 1 };
                 let (mut at, mut walked) = (j + n, 0.0);
@@ -75,7 +80,7 @@ pub fn flattest_sample(sections: &[Section], w: f64, room: f64) -> usize {
                     } else {
                         p(to).z
                     };
-                    *worst = worst.max(here.z - z);
+                    drop = drop.max(here.z - z);
                     walked += step;
                     at = to;
                     if walked >= window {
@@ -83,10 +88,14 @@ pub fn flattest_sample(sections: &[Section], w: f64, room: f64) -> usize {
                     }
                 }
             }
+            *worst = worst.max(drop - room);
         }
     }
+    if !any {
+        return 0;
+    }
     let least = score.iter().copied().fold(f64::INFINITY, f64::min);
-    if !least.is_finite() || score[0] <= room || score[0] <= least + AS_FLAT_MM {
+    if !least.is_finite() || score[0] <= 0.0 || score[0] <= least + AS_FLAT_MM {
         return 0;
     }
     score
@@ -134,37 +143,34 @@ mod tests {
 
     #[test]
     fn level_layers_keep_the_seam_where_the_contours_start() {
-        assert_eq!(flattest_sample(&rings(180, 40, 0, |_| 0.0), 3.0, 0.0), 0);
-        assert_eq!(flattest_sample(&[], 3.0, 0.0), 0);
+        assert_eq!(
+            flattest_sample(&rings(180, 40, 0, |_| 0.0), 3.0, 2, 0.25),
+            0
+        );
+        assert_eq!(flattest_sample(&[], 3.0, 2, 0.25), 0);
     }
 
     #[test]
-    fn a_tilted_top_moves_the_seam_to_its_lowest_side() {
-        // Sine tilt, highest at 90° and lowest at 270° (sample 135 of 180).
+    fn a_tilted_top_moves_the_seam_where_its_layers_are_level_and_thickest() {
+        // Sine tilt, highest at 90° (sample 45 of 180), lowest at 270°: level at both, its
+        // layers 0.7 + 0.5 mm thick at the top of the high side, 0.7 − 0.5 at the low side.
         let sections = rings(180, 60, 20, |a| 10.0 * a.sin());
-        assert_eq!(flattest_sample(&sections, 3.0, 0.0), 135);
-        // A tilt whose valley is at the contours' start keeps it there (searched for however
-        // little room there is).
+        assert_eq!(flattest_sample(&sections, 3.0, 2, 0.25), 45);
+        // Turned: highest at 180° (sample 90).
         let sections = rings(180, 60, 20, |a| -10.0 * a.cos());
-        assert_eq!(flattest_sample(&sections, 3.0, -1.0), 0);
-        // Two peaks and two valleys, straight between them (a control line's corners): the
-        // first valley, though the lower peak is flatter across.
-        let zigzag = |a: f64| {
-            let t = (a / std::f64::consts::FRAC_PI_2).rem_euclid(4.0);
-            let up = [6.0, 1.8][usize::from(t >= 2.0)];
-            up * (1.0 - ((t % 2.0) - 1.0).abs())
-        };
-        let sections = rings(60, 30, 10, zigzag);
-        assert_eq!(flattest_sample(&sections, 3.0, -1.0), 0);
+        assert_eq!(flattest_sample(&sections, 3.0, 2, 0.25), 90);
     }
 
     #[test]
     fn a_seam_with_room_for_its_slope_stays_where_the_contours_start() {
-        // Half a bead and a tenth (1.65 mm, 2.7° on a 35 mm ring) before 0°, the top ring lies
-        // 10·sin 2.7° ≈ 0.47 mm below it.
+        // Half a bead and a tenth (1.65 mm, 2.7° on a 35 mm ring) before 0°, the top ring
+        // (lifted 0.95 of the way) lies 0.95·10·sin 2.7° ≈ 0.45 mm below it; at 0° the layers
+        // are 0.7 mm. Two beads leave the turns 0.35 − 0.45 mm over the step there, one bead
+        // 0.7 − 0.45 = 0.25 mm: room for a 0.2 mm layer, not for 0.3 mm.
         let sections = rings(180, 60, 20, |a| 10.0 * a.sin());
-        assert_eq!(flattest_sample(&sections, 3.0, 0.4), 135);
-        assert_eq!(flattest_sample(&sections, 3.0, 0.5), 0);
+        assert_eq!(flattest_sample(&sections, 3.0, 2, 0.25), 45);
+        assert_eq!(flattest_sample(&sections, 3.0, 1, 0.2), 0);
+        assert_eq!(flattest_sample(&sections, 3.0, 1, 0.3), 45);
     }
 
     #[test]
