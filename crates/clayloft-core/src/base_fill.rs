@@ -474,11 +474,7 @@ fn add_middles(
 /// rings face each other across a bridge they then run in opposite directions.
 fn orient(node: &mut Node, anticlockwise: bool, w: f64) {
     if (crate::geometry::signed_area(&node.ring.pts) > 0.0) != anticlockwise {
-        let mut pts = std::mem::take(&mut node.ring.pts);
-        pts.reverse();
-        // Keep the same first point.
-        pts.rotate_right(1);
-        node.ring = Ring::new(pts);
+        node.ring = Ring::new(facing(std::mem::take(&mut node.ring.pts), anticlockwise));
     }
     if node.step > 0.0 {
         node.ring.spurs = corner_spurs(&node.ring, anticlockwise, node.step, w);
@@ -486,6 +482,15 @@ fn orient(node: &mut Node, anticlockwise: bool, w: f64) {
     for child in &mut node.children {
         orient(child, !anticlockwise, w);
     }
+}
+
+/// The ring `pts` running anticlockwise or clockwise as asked, from the same first point.
+fn facing(mut pts: Vec<DVec2>, anticlockwise: bool) -> Vec<DVec2> {
+    if (crate::geometry::signed_area(&pts) > 0.0) != anticlockwise {
+        pts.reverse();
+        pts.rotate_right(1);
+    }
+    pts
 }
 
 /// Leaves out the spurs that would cross a ring (on a jagged foot a corner's bisector can run
@@ -788,13 +793,9 @@ fn own_children(
                 .total_cmp(&centre(&own[b].1).distance(at))
         })?;
         used[k] = true;
-        let (inner, mut pts) = own[k].clone();
+        let (inner, pts) = own[k].clone();
         // Each ring runs opposite to the ring around it (see [`orient`]).
-        if (crate::geometry::signed_area(&pts) > 0.0) == anticlockwise {
-            pts.reverse();
-            pts.rotate_right(1);
-        }
-        let mut ring = Ring::new(pts);
+        let mut ring = Ring::new(facing(pts, !anticlockwise));
         ring.spurs = corner_spurs(&ring, !anticlockwise, w, w);
         let grandchildren = if levels > 1 {
             own_children(&old.children[c], &inner, w, levels - 1, !anticlockwise)?
