@@ -14,7 +14,7 @@ use clayloft_core::gcode::{JobSummary, format_duration, summarize};
 // each other closely (see `clayloft_core::parallel`).
 use clayloft_core::parallel::awake;
 use clayloft_core::stl::{job_mesh, write_ascii_stl, write_binary_stl};
-use clayloft_core::{LoadedDesign, PrintJob, load_design};
+use clayloft_core::{Design, LoadedDesign, PrintJob, load_design};
 
 /// The design opened when none is given.
 const DEFAULT_DESIGN: &str = "assets/designs/petal-vase.toml";
@@ -254,9 +254,19 @@ pub fn default_design() -> PathBuf {
 
 /// Loads a design and runs the pipeline, with errors located in the file.
 pub fn job_of(path: &Path, printer: Option<&str>) -> Result<(LoadedDesign, PrintJob), Failure> {
+    job_by(clayloft_core::run, path, printer)
+}
+
+/// The design at `path` (on `printer`, if named) and its job, computed by `run` (the whole
+/// pipeline, or all of it but the verdict).
+fn job_by(
+    run: fn(&Design) -> Result<PrintJob, clayloft_core::validate::FieldError>,
+    path: &Path,
+    printer: Option<&str>,
+) -> Result<(LoadedDesign, PrintJob), Failure> {
     let loaded = clayloft_core::load::load_design_using(path, printer)?;
     clayloft_core::heap::fault_ahead_for(&loaded.design);
-    let job = clayloft_core::run(&loaded.design).map_err(|e| loaded.locate(e))?;
+    let job = run(&loaded.design).map_err(|e| loaded.locate(e))?;
     Ok((loaded, job))
 }
 
@@ -388,20 +398,23 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
 }
 
 fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
-    let (loaded, job) = job_of(design, printer)?;
+    // The verdict on the print is left for the end (below).
+    let (loaded, mut job) = job_by(clayloft_core::pipeline::run_unjudged, design, printer)?;
     // Right first time: the program is re-measured by the checker on its way to the disk, and
     // a design that still breaks a limit on this printer is refused with what broke.
     let written = write_checked_gcode(&loaded.design, &job, out).map_err(|e| match e {
         ExportError::Refused { .. } => Failure(format!("{}: {e}", loaded.path.display())),
         other => Failure(other.to_string()),
     })?;
-    // The file replaced is freed on the second core while this one prints.
+    // The system frees the file replaced on a thread of its own, mostly waiting for the disk,
+    // while the cores judge the print (or here, where no thread can be started).
     let replaced = written.replaced;
-    clayloft_core::parallel::both(
-        true,
-        move || drop(replaced),
-        || print_summary(&loaded, &job, Some(written.summary)),
-    );
+    let freeing = std::thread::Builder::new().spawn(move || drop(replaced));
+    job.verdict = clayloft_core::pipeline::judge(&loaded.design, &job);
+    print_summary(&loaded, &job, Some(written.summary));
+    if let Ok(freeing) = freeing {
+        let _ = freeing.join();
+    }
     if !written.unenforced.is_empty() {
         println!(
             "the checker finds in this G-code (constraints not enforced: written as designed):"

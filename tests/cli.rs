@@ -556,7 +556,29 @@ fn clay_bodies_printability_and_shrinkage_on_the_command_line() {
         std::fs::write(&path, design).unwrap();
         let out = clayloft(&["info", path.to_str().unwrap()]);
         assert!(out.status.success(), "{}", text(&out.stderr));
-        text(&out.stdout)
+        // `gcode` judges the print once its program is in place: the same verdict.
+        let gcode_path = dir.path().join(format!("{name}.gcode"));
+        let written = clayloft(&[
+            "gcode",
+            path.to_str().unwrap(),
+            "-o",
+            gcode_path.to_str().unwrap(),
+        ]);
+        assert!(written.status.success(), "{}", text(&written.stderr));
+        let verdict = |said: &str| -> Vec<String> {
+            said.lines()
+                .filter(|l| {
+                    ["printability:", "warning:", "droop"]
+                        .iter()
+                        .any(|w| l.starts_with(w))
+                })
+                .map(String::from)
+                .collect()
+        };
+        let said = text(&out.stdout);
+        assert!(!verdict(&said).is_empty(), "{said}");
+        assert_eq!(verdict(&text(&written.stdout)), verdict(&said));
+        said
     };
     // The shipped example stands, and says so.
     let good = run("good", GOOD);

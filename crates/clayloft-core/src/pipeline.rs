@@ -306,3 +306,22 @@ pub fn run(design: &Design) -> Result<PrintJob, FieldError> {
     session.update(design)?;
     Ok(session.job().expect("a successful update has a job"))
 }
+
+/// [`run`] without the printability verdict (`verdict` is `None`), for a caller with other
+/// work to set it beside: [`judge`] gives it. (`clayloft gcode` judges the job once its
+/// program is in place, while the system frees the file it replaced: a wait on the disk of
+/// 2–3 ms here, which the verdict's 2–4 ms of work now fills.)
+pub fn run_unjudged(design: &Design) -> Result<PrintJob, FieldError> {
+    let mut session = Session::for_one_unjudged_update();
+    session.update(design)?;
+    Ok(session.job().expect("a successful update has a job"))
+}
+
+/// The printability verdict [`run`] gives `job`, a job of `design` (judged at its wet size:
+/// see [`crate::clay::wet_design`]).
+pub fn judge(design: &Design, job: &PrintJob) -> Option<Arc<crate::printability::Printability>> {
+    let wet = crate::clay::wet_design(design).ok()?;
+    crate::printability::assess(&wet, &job.surface, &job.toolpath)
+        .ok()
+        .map(Arc::new)
+}

@@ -18,7 +18,8 @@
 //!    (`pipeline::finish_surface`);
 //! 5. the base fill of the feet (`toolpath::base_fills`), kept while the feet do not change;
 //! 6. the toolpath: the one continuous spiral (`toolpath::build_toolpath_on`);
-//! 7. the verdict: whether the wet wall stands while it is printed (`printability::assess`);
+//! 7. the verdict: whether the wet wall stands while it is printed (`printability::assess`),
+//!    but in a session made [`Session::for_one_unjudged_update`];
 //! 8. for a session made [`Session::with_wall_view`], the wall's mesh for a 3D view
 //!    (`view_mesh::wall_buffers`), so that an application's view and replay share one; it is
 //!    built on a second core from the moment the base fill's rings are made (beside the
@@ -316,6 +317,8 @@ pub struct Session {
     wall_view: bool,
     /// Whether this session serves a single update ([`Session::for_one_update`]).
     one_update: bool,
+    /// Whether the verdict stage is left to the caller ([`Session::for_one_unjudged_update`]).
+    unjudged: bool,
 }
 
 impl Session {
@@ -469,7 +472,10 @@ impl Session {
         findings.extend(crate::shape::fold_findings(&self.section_folds));
         finish_stages(
             &mut self.later,
-            self.wall_view,
+            Kept {
+                wall_view: self.wall_view,
+                verdict: !self.unjudged,
+            },
             design,
             &mut done,
             grid,
@@ -512,6 +518,15 @@ impl Session {
         Session {
             one_update: true,
             ..Session::default()
+        }
+    }
+
+    /// [`Session::for_one_update`] without the verdict stage: its job's `verdict` is `None`, for
+    /// a caller that judges the job later, beside other work ([`crate::pipeline::run_unjudged`]).
+    pub fn for_one_unjudged_update() -> Session {
+        Session {
+            unjudged: true,
+            ..Session::for_one_update()
         }
     }
 
@@ -688,7 +703,10 @@ impl Session {
         let wall = self.mesh_wall.get().expect("the wall stage ran above");
         finish_stages(
             &mut self.later,
-            self.wall_view,
+            Kept {
+                wall_view: self.wall_view,
+                verdict: !self.unjudged,
+            },
             design,
             done,
             grid,
@@ -701,12 +719,12 @@ impl Session {
 
 /// The stages every design shares once its shaped sections are known: the texture's
 /// displacements, the corrected surface (its key holds the revisions `inputs` of what the
-/// sections came from), the base fill, the beads, the toolpath, its verdict and (`wall_view`)
-/// the wall's mesh for a view.
+/// sections came from), the base fill, the beads, the toolpath, and as `kept` says its verdict
+/// and the wall's mesh for a view.
 #[allow(clippy::too_many_arguments)]
 fn finish_stages(
     later: &mut LaterStages,
-    wall_view: bool,
+    Kept { wall_view, verdict }: Kept,
     design: &Design,
     done: &mut Update,
     grid: crate::pipeline::SectionGrid,
@@ -858,11 +876,20 @@ fn finish_stages(
         line_width: p.line_width,
     };
     done.verdict = later.verdict.refresh(verdict_key, || {
-        Ok(crate::printability::assess(design, &surface, toolpath)
-            .ok()
+        Ok(verdict
+            .then(|| crate::printability::assess(design, &surface, toolpath).ok())
+            .flatten()
             .map(Arc::new))
     })?;
     Ok(())
+}
+
+/// The stages after the toolpath that a session keeps: the wall's mesh for a view
+/// ([`Session::with_wall_view`]) and the verdict (all but [`Session::for_one_unjudged_update`]).
+#[derive(Clone, Copy)]
+struct Kept {
+    wall_view: bool,
+    verdict: bool,
 }
 
 /// Shapes the sections `ks` of `model`, shared out over the machine's cores in runs of
@@ -1000,11 +1027,21 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
             fresh.update(d).map(|_| fresh.job().unwrap())
         };
         let once = crate::run(d);
+        // `clayloft gcode`'s run, judged once its program is written.
+        let unjudged = crate::pipeline::run_unjudged(d);
         match (result, batch) {
             (Ok(_), Ok(b)) => {
                 let job = session.job().unwrap();
                 assert_eq!(*job.surface, *b.surface, "surface differs from a batch run");
                 let once = once.expect("the batch run fails where a fresh session does not");
+                let unjudged = unjudged.expect("the unjudged run fails where a fresh one does not");
+                assert!(unjudged.verdict.is_none());
+                assert_eq!(*unjudged.toolpath, *once.toolpath);
+                assert_eq!(
+                    crate::pipeline::judge(d, &unjudged),
+                    once.verdict,
+                    "the verdict judged after the run differs"
+                );
                 assert!(once.surface.point_leans_deg.is_empty());
                 assert_eq!(
                     *once.surface,
@@ -1046,6 +1083,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
             (Err(e), Err(b)) => {
                 assert_eq!(e.to_string(), b.to_string());
                 assert_eq!(once.map(|_| ()).unwrap_err().to_string(), b.to_string());
+                assert_eq!(unjudged.map(|_| ()).unwrap_err().to_string(), b.to_string());
                 assert!(!session.is_current());
             }
             (a, b) => panic!("incremental {a:?} but batch {:?}", b.map(|_| ())),
