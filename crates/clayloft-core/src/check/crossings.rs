@@ -28,6 +28,11 @@
 //! quarter of the windows pass the first test (its textured belly, its base's rings), and
 //! about one pair in a chord is tested.
 //!
+//! A block whose wall goes on round but steps back here and there (a texture on a petalled
+//! wall: the benchmark vase's belly) is settled by the chords' angles round its middle instead
+//! ([`Work::judge_by_angles`]): two chords of a window that goes round less than once cross
+//! only where the angles they sweep overlap, which near a step back alone they do.
+//!
 //! The chords are judged in blocks on every core; each block reads the path back as far as its
 //! first chord's window reaches, so the loops found do not depend on the number of cores.
 
@@ -177,6 +182,9 @@ struct Work {
     groups: Vec<ChordBox>,
     /// Unwrapped direction.
     turn: Vec<f64>,
+    /// The least and greatest unwrapped angle round the block's middle of each chord's points
+    /// ([`Work::judge_by_angles`]).
+    sweeps: Vec<(f64, f64)>,
     /// Times the path has crossed the ray from the block's middle towards +x, anticlockwise
     /// less clockwise, by each chord's end: with the angle there, the unwrapped angle round
     /// the middle.
@@ -222,6 +230,9 @@ impl Work {
         let centre = centre_of(&v[chords[first].0..=chords[block.end - 1].1]);
         if self.goes_round_less_than_once(path, first, block.clone(), centre) {
             return judged;
+        }
+        if let Some(by_angles) = self.judge_by_angles(path, first, block.clone(), centre, budget) {
+            return by_angles;
         }
         let chord = |c: usize| (v[chords[first + c].0], v[chords[first + c].1]);
         let count = all.len();
@@ -398,6 +409,140 @@ impl Work {
             let before = start.checked_sub(1).map_or(0.0, |k| self.turn[k]);
             (self.turn[c] - before).abs() < 4.0 - 1e-6
         })
+    }
+
+    /// [`Work::judge`]'s loops of `block` (windows from chord `first`, `budget` left), where
+    /// the chords' angles round `centre` settle most pairs; `None` where they cannot (the
+    /// block is then judged chord by chord).
+    ///
+    /// A chord that does not pass within a half-turn of the centre's far side sweeps the angles
+    /// between its ends' (less than a half-turn), and two chords that cross share the angle of
+    /// their crossing. Unwrapped along the path (its chords' sweeps added up), the angles of a
+    /// stretch that goes round less than once stand for their directions one to one: two chords
+    /// of one window cross only where their sweeps overlap. A wall that goes on round its axis
+    /// but steps back here and there (a texture on a fluted or petalled wall, which makes
+    /// [`Work::goes_round_less_than_once`] fail on a block) has a few such pairs at each step
+    /// back, tested as [`Work::judge`] tests them; every other chord is settled by comparing its
+    /// sweep with the extremes of its window's (two sliding extremes). About a third of the
+    /// cost of judging the chords one by one, with the same loops.
+    ///
+    /// `None` where the heights do not rise along the block (the windows are not the rising
+    /// ones), a chord sweeps nearly a half-turn or has no direction from the centre, a window
+    /// spans a whole turn, or the budget runs out.
+    fn judge_by_angles<U: Fn(usize) -> bool>(
+        &mut self,
+        path: &Path<U>,
+        first: usize,
+        block: std::ops::Range<usize>,
+        centre: DVec2,
+        mut budget: usize,
+    ) -> Option<Judged> {
+        let (v, chords, limits, usable) = (path.v, path.chords, path.limits, path.usable);
+        let count = block.end - first;
+        let head = block.start - first;
+        let chord = |c: usize| (v[chords[first + c].0], v[chords[first + c].1]);
+        // Each chord's box and sweep (the least and greatest of its ends' unwrapped angles).
+        self.boxes.clear();
+        self.sweeps.clear();
+        // The last chord's end: its point and its pseudo-angle.
+        let mut last: Option<(usize, f64)> = None;
+        let mut angle = 0.0;
+        for c in 0..count {
+            let (a, b) = chord(c);
+            let bx = ChordBox::of(a, b);
+            if let Some(prev) = self.boxes.last()
+                && !(prev.lo.z <= bx.lo.z && prev.hi.z <= bx.hi.z)
+            {
+                return None;
+            }
+            self.boxes.push(bx);
+            // A chord mostly starts where the last one ended: its pseudo-angle is known.
+            let qa = match last {
+                Some((end, q)) if end == chords[first + c].0 => q,
+                _ => pseudo_angle(a.truncate() - centre),
+            };
+            if let Some((_, q)) = last {
+                // The path's step from the last chord's end to this one's start (none where
+                // the chords share their point).
+                angle += wrapped(qa - q);
+            }
+            let qb = pseudo_angle(b.truncate() - centre);
+            let sweep = wrapped(qb - qa);
+            // Not a number for a chord end at the centre; a half-turn through it.
+            if !(sweep.abs() < 1.9) || !angle.is_finite() {
+                return None;
+            }
+            let start = angle;
+            angle += sweep;
+            self.sweeps.push((start.min(angle), start.max(angle)));
+            last = Some((chords[first + c].1, qb));
+        }
+        // Rounding of the pseudo-angles and their sums, far below this.
+        const SLACK: f64 = 1e-9;
+        let mut judged = Judged {
+            loops: Vec::new(),
+            tested: 0,
+            complete: true,
+        };
+        self.highs.clear();
+        self.lows.clear();
+        let (mut height_from, mut length_from) = (0, 0);
+        for c in 0..count {
+            let bx = self.boxes[c];
+            // The window, as [`Work::judge`] finds it where the heights rise.
+            let below = bx.lo.z - limits.same_layer;
+            while height_from < c && self.boxes[height_from].hi.z < below {
+                height_from += 1;
+            }
+            let start = height_from.max(path.length_start(first, c, &mut length_from));
+            // The chords up to c − 2 in the sliding extremes.
+            if let Some(k) = c.checked_sub(2) {
+                let sweeps = &self.sweeps;
+                self.highs.push(k, |i| sweeps[i].1 <= sweeps[k].1);
+                self.lows.push(k, |i| sweeps[i].0 >= sweeps[k].0);
+            }
+            if c < head || c < start + 2 {
+                continue;
+            }
+            self.highs.drop_before(start);
+            self.lows.drop_before(start);
+            let sweeps = &self.sweeps;
+            let (high, low) = (sweeps[self.highs.first()].1, sweeps[self.lows.first()].0);
+            let (lo, hi) = sweeps[c];
+            // The window's angles within less than a whole turn.
+            let span = high.max(sweeps[c - 1].1).max(hi) - low.min(sweeps[c - 1].0).min(lo);
+            if !(span < 4.0 - 1e-6) {
+                return None;
+            }
+            // No earlier chord of the window sweeps an angle of this one's.
+            if high < lo - SLACK || low > hi + SLACK || !usable(first + c) {
+                continue;
+            }
+            let near = bx.widened(limits.same_layer);
+            let mut widest: Option<f64> = None;
+            for i in start..c - 1 {
+                let (l, h) = sweeps[i];
+                if h < lo - SLACK || l > hi + SLACK {
+                    continue;
+                }
+                judged.tested += 1;
+                budget = budget.checked_sub(1)?;
+                if !self.boxes[i].meets(&near) || !usable(first + i) {
+                    continue;
+                }
+                let (ci, cc) = (chords[first + i], chords[first + c]);
+                if let Some(reach) = loop_reach(v, ci, cc, limits, &mut budget) {
+                    widest = Some(widest.map_or(reach, |w| w.max(reach)));
+                }
+                if budget == 0 {
+                    return None;
+                }
+            }
+            if let Some(reach) = widest {
+                judged.loops.push((reach, first + c));
+            }
+        }
+        Some(judged)
     }
 
     /// Whether chords `from ..= to` go all round `centre` (their ends' unwrapped angles a
@@ -742,6 +887,43 @@ mod tests {
             assert_eq!(search(&v).events.len(), expected, "{waves} {out} {along}");
         }
         assert!((2..12).contains(&looped), "{looped} of the textures loop");
+    }
+
+    /// A petalled wall whose texture steps it back round its axis at every wave (as the
+    /// benchmark vase's does on its petals' flanks), some waves far enough to loop: its windows
+    /// go both ways round, the chords' angles settle all but the pairs at the steps back, and
+    /// the loops are those testing every pair finds.
+    #[test]
+    fn a_wall_stepping_back_at_every_wave_is_settled_by_its_angles() {
+        for (along, loops) in [(0.6, false), (0.9, true), (6.0, true)] {
+            let v = spiral(3.0, 720, move |t| {
+                let a = TAU * t;
+                let (radial, tangent) =
+                    (DVec2::new(a.cos(), a.sin()), DVec2::new(-a.sin(), a.cos()));
+                let w = TAU * 60.0 * t;
+                radial * (8.0 * (6.0 * a).cos() + 0.8 * w.cos()) + tangent * (along * w.sin())
+            });
+            let steps_back = v
+                .windows(2)
+                .filter(|s| {
+                    let c = DVec2::new(100.0, 100.0);
+                    (s[0].truncate() - c).perp_dot(s[1].truncate() - c) <= 0.0
+                })
+                .count();
+            assert!(steps_back > 20, "{along}: {steps_back} steps back");
+            let found = search(&v);
+            assert!(found.complete);
+            assert_eq!(found.events.len(), every_pair(&v), "{along}");
+            assert_eq!(!found.events.is_empty(), loops, "{along}");
+            if !loops {
+                // A few pairs a step back, not every chord's window.
+                assert!(
+                    found.tested < v.len() / 4,
+                    "{along}: {} pairs tested",
+                    found.tested
+                );
+            }
+        }
     }
 
     #[test]
