@@ -407,12 +407,15 @@ fn write_program_indexed(
             crate::thumbnail::header_blocks(&points)
         })
     });
-    let body = BodyWriter::new(
-        design,
-        tp,
-        (sums.nominal_s, summary.estimated_time_s),
-        layers_total,
-    );
+    let body = BodyWriter {
+        steps: Some(&sums.steps),
+        ..BodyWriter::new(
+            design,
+            tp,
+            (sums.nominal_s, summary.estimated_time_s),
+            layers_total,
+        )
+    };
     let starts = body.chunk_starts(&sums);
     let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
@@ -631,6 +634,9 @@ struct PathSums {
     starts: Vec<BodyState>,
     /// ... the time done before the chunk's last point was written, whose percent it is.
     percent_times: Vec<Option<f64>>,
+    /// Each segment's time at its point's speed, s, and E (relative), as the body's writer
+    /// adds them: `steps[i − 1]` for the segment to point i.
+    steps: Vec<(f64, f64)>,
 }
 
 impl PathSums {
@@ -651,6 +657,7 @@ impl PathSums {
         let mut starts = vec![BodyState::START];
         let mut percent_times = vec![None];
         let mut percent_before = None;
+        let mut steps = Vec::with_capacity(n.saturating_sub(1));
         for i in 1..n {
             let q = &points[i];
             if (i - 1) % BODY_CHUNK == 0 && i > 1 {
@@ -663,12 +670,15 @@ impl PathSums {
                 None => points[i - 1].pos.distance(q.pos),
             };
             length += d;
-            st.t_done += d / q.speed;
+            let dt = d / q.speed;
+            st.t_done += dt;
             let v = segment_volume(design, tp, i);
             volume += v;
+            let e = v * e_per_mm3;
             if absolute {
-                st.e_total += v * e_per_mm3;
+                st.e_total += e;
             }
+            steps.push((dt, e));
             (lo, hi) = (lo.min(q.pos), hi.max(q.pos));
             st.last_speed = q.speed;
             while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
@@ -682,6 +692,7 @@ impl PathSums {
             bounds: (lo, hi),
             starts,
             percent_times,
+            steps,
         }
     }
 }
@@ -726,6 +737,9 @@ struct BodyWriter<'a> {
     /// Planned over nominal time: M73's minutes left count down to the planned end.
     scale: f64,
     layers_total: usize,
+    /// Each segment's time and E where known already ([`PathSums::steps`]), else measured as
+    /// the points are written.
+    steps: Option<&'a [(f64, f64)]>,
 }
 
 impl<'a> BodyWriter<'a> {
@@ -747,6 +761,7 @@ impl<'a> BodyWriter<'a> {
             nominal,
             scale: planned_s / nominal,
             layers_total,
+            steps: None,
         }
     }
 
@@ -928,9 +943,14 @@ impl<'a> BodyWriter<'a> {
                     st.last_percent = percent;
                 }
             }
-            let prev = &tp.points[i - 1];
-            st.t_done += prev.pos.distance(q.pos) / q.speed;
-            let e = segment_volume(self.design, tp, i) * self.e_per_mm3;
+            let (dt, e) = match self.steps {
+                Some(steps) => steps[i - 1],
+                None => (
+                    tp.points[i - 1].pos.distance(q.pos) / q.speed,
+                    segment_volume(self.design, tp, i) * self.e_per_mm3,
+                ),
+            };
+            st.t_done += dt;
             let (x, y, z, e) = Line::append(buf, |line| {
                 line.text(b"G1 X");
                 let x = number::<3>(line, q.pos.x - ox, MOVES);
@@ -1122,7 +1142,8 @@ mod tests {
     }
 
     /// The body written in rounds of chunks, on both cores, each from the state its chunk's
-    /// sums reach, is the body formatted in one piece on one: a path of more than a round of
+    /// sums reach and with each segment's time and E from the sums, is the body formatted in
+    /// one piece on one, measuring them point by point: a path of more than a round of
     /// chunks (the last short) whose speeds change, with and without host metadata and
     /// progress, in either E mode.
     #[test]
@@ -1163,16 +1184,24 @@ mod tests {
         ] {
             (d.printer.host_metadata, d.printer.progress) = (metadata, progress);
             d.printer.extrusion = extrusion;
-            let body = BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
+            // The chunks written with each segment's time and E from the path's sums (as the
+            // program is), the whole measured as it is written.
+            let measuring =
+                BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
+            let sums = PathSums::of(&d, &tp, None);
+            let body = BodyWriter {
+                steps: Some(&sums.steps),
+                ..measuring
+            };
             let (mut text, mut index) = (Vec::new(), Vec::new());
             crate::parallel::awake(|| {
-                body.write(
-                    &mut text,
-                    &mut Some(&mut index),
-                    &body.chunk_starts(&PathSums::of(&d, &tp, None)),
-                )
+                body.write(&mut text, &mut Some(&mut index), &body.chunk_starts(&sums))
             })
             .unwrap();
+            let body = BodyWriter {
+                steps: None,
+                ..body
+            };
             let mut whole = Piece::default();
             let want = Wanted {
                 index: true,
