@@ -8,6 +8,10 @@ pause (a single command after the machine idled, as a potter runs it).
 
 Prints the minimum, first quartile, median and maximum wall time of each, in ms, and the median
 processor time (user and system, both cores together), which a busy shared machine moves less.
+With two or more binaries, also each one's wall and processor time over the first's, round by
+round, as the median of those ratios: the machine's drift within a round falls on both, so a
+change of a few percent shows where the medians of a drifting hour hide it. The order within
+a round alternates from round to round.
 """
 import argparse
 import os
@@ -30,8 +34,8 @@ with tempfile.TemporaryDirectory() as work:
     out = str(Path(work) / "vase.gcode")
     times = {b: [] for b in args.binaries}
     cpu = {b: [] for b in args.binaries}
-    for _ in range(args.rounds):
-        for b in args.binaries:
+    for r in range(args.rounds):
+        for b in (args.binaries if r % 2 == 0 else args.binaries[::-1]):
             time.sleep(args.pause)
             start = time.perf_counter()
             child = subprocess.Popen([b, "gcode", args.design, "-o", out],
@@ -41,6 +45,11 @@ with tempfile.TemporaryDirectory() as work:
             if os.waitstatus_to_exitcode(status) != 0:
                 raise SystemExit(f"{b} gcode {args.design} failed")
             cpu[b].append((usage.ru_utime + usage.ru_stime) * 1000)
+    first = args.binaries[0]
+    for b in args.binaries[1:]:
+        wall = statistics.median(t / f for t, f in zip(times[b], times[first]))
+        proc = statistics.median(c / f for c, f in zip(cpu[b], cpu[first]) if f > 0)
+        print(f"{b} over {first}, round by round: wall {wall:.3f}, processor {proc:.3f} (medians)")
     for b, t in times.items():
         t.sort()
         print(f"{b}: min {t[0]:.1f}  p25 {t[len(t) // 4]:.1f}  "

@@ -469,7 +469,7 @@ impl Work {
             let qb = pseudo_angle(b.truncate() - centre);
             let sweep = wrapped(qb - qa);
             // Not a number for a chord end at the centre; a half-turn through it.
-            if !(sweep.abs() < 1.9) || !angle.is_finite() {
+            if sweep.is_nan() || sweep.abs() >= 1.9 || !angle.is_finite() {
                 return None;
             }
             let start = angle;
@@ -511,7 +511,7 @@ impl Work {
             let (lo, hi) = sweeps[c];
             // The window's angles within less than a whole turn.
             let span = high.max(sweeps[c - 1].1).max(hi) - low.min(sweeps[c - 1].0).min(lo);
-            if !(span < 4.0 - 1e-6) {
+            if span.is_nan() || span >= 4.0 - 1e-6 {
                 return None;
             }
             // No earlier chord of the window sweeps an angle of this one's.
