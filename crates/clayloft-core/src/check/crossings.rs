@@ -441,12 +441,25 @@ impl Work {
         let count = block.end - first;
         let head = block.start - first;
         let chord = |c: usize| (v[chords[first + c].0], v[chords[first + c].1]);
-        // Each chord's box and sweep (the least and greatest of its ends' unwrapped angles).
+        // Rounding of the pseudo-angles and their sums, far below this.
+        const SLACK: f64 = 1e-9;
+        let mut judged = Judged {
+            loops: Vec::new(),
+            tested: 0,
+            complete: true,
+        };
+        // Each chord read in turn: its box and sweep (the least and greatest of its ends'
+        // unwrapped angles), then its window and the pairs it may close, so that a block that
+        // cannot be settled this way (a base's rings, which go round within a window) is given
+        // up at its first such window.
         self.boxes.clear();
         self.sweeps.clear();
+        self.highs.clear();
+        self.lows.clear();
         // The last chord's end: its point and its pseudo-angle.
         let mut last: Option<(usize, f64)> = None;
         let mut angle = 0.0;
+        let (mut height_from, mut length_from) = (0, 0);
         for c in 0..count {
             let (a, b) = chord(c);
             let bx = ChordBox::of(a, b);
@@ -472,23 +485,10 @@ impl Work {
             if sweep.is_nan() || sweep.abs() >= 1.9 || !angle.is_finite() {
                 return None;
             }
-            let start = angle;
+            let from = angle;
             angle += sweep;
-            self.sweeps.push((start.min(angle), start.max(angle)));
+            self.sweeps.push((from.min(angle), from.max(angle)));
             last = Some((chords[first + c].1, qb));
-        }
-        // Rounding of the pseudo-angles and their sums, far below this.
-        const SLACK: f64 = 1e-9;
-        let mut judged = Judged {
-            loops: Vec::new(),
-            tested: 0,
-            complete: true,
-        };
-        self.highs.clear();
-        self.lows.clear();
-        let (mut height_from, mut length_from) = (0, 0);
-        for c in 0..count {
-            let bx = self.boxes[c];
             // The window, as [`Work::judge`] finds it where the heights rise.
             let below = bx.lo.z - limits.same_layer;
             while height_from < c && self.boxes[height_from].hi.z < below {
