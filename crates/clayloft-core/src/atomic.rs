@@ -47,9 +47,9 @@ pub struct Pending {
 }
 
 /// The file a commit replaced, kept open: the system frees a replaced file's data when its
-/// last name and descriptor are gone (2 ms for the benchmark vase's 8 MB of G-code here), so
-/// this frees it when dropped, where it costs the caller nothing (`clayloft gcode` drops it on
-/// the second core while this one prints the summary).
+/// last name and descriptor are gone (2–3 ms for the benchmark vase's 8 MB of G-code here,
+/// mostly waiting for the disk), so this frees it when dropped, where it costs the caller
+/// nothing (`clayloft gcode` drops it on a thread of its own while both cores judge the print).
 #[must_use = "dropped at once, the old file's data is freed here"]
 pub struct Replaced(#[allow(dead_code)] Option<std::fs::File>);
 
