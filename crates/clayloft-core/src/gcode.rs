@@ -407,15 +407,7 @@ fn write_program_indexed(
             crate::thumbnail::header_blocks(&points)
         })
     });
-    let body = BodyWriter {
-        steps: Some(&sums.steps),
-        ..BodyWriter::new(
-            design,
-            tp,
-            (sums.nominal_s, summary.estimated_time_s),
-            layers_total,
-        )
-    };
+    let body = BodyWriter::new(design, tp, &sums, summary.estimated_time_s, layers_total);
     let starts = body.chunk_starts(&sums);
     let values = template_values(design, job, &summary);
     let fill = |field: &'static str, t: &str| {
@@ -731,37 +723,35 @@ struct BodyWriter<'a> {
     design: &'a Design,
     tp: &'a Toolpath,
     origin: [f64; 2],
-    e_per_mm3: f64,
     /// Print time at nominal speeds (the M73 percentages are of it), s.
     nominal: f64,
     /// Planned over nominal time: M73's minutes left count down to the planned end.
     scale: f64,
     layers_total: usize,
-    /// Each segment's time and E where known already ([`PathSums::steps`]), else measured as
-    /// the points are written.
-    steps: Option<&'a [(f64, f64)]>,
+    /// Each segment's time and E ([`PathSums::steps`]).
+    steps: &'a [(f64, f64)],
 }
 
 impl<'a> BodyWriter<'a> {
-    /// The writer of `tp`'s body, whose print time is `nominal_s` at the points' speeds
-    /// ([`Toolpath::print_time`]) and `planned_s` as planned.
+    /// The writer of `tp`'s body from its `sums` (its print time at the points' speeds,
+    /// [`Toolpath::print_time`], and each segment's time and E), planned to take `planned_s`.
     fn new(
         design: &'a Design,
         tp: &'a Toolpath,
-        (nominal_s, planned_s): (f64, f64),
+        sums: &'a PathSums,
+        planned_s: f64,
         layers_total: usize,
     ) -> Self {
         let p = &design.printer;
-        let nominal = nominal_s.max(1e-9);
+        let nominal = sums.nominal_s.max(1e-9);
         BodyWriter {
             design,
             tp,
             origin: p.origin_offset(),
-            e_per_mm3: e_per_mm3(p),
             nominal,
             scale: planned_s / nominal,
             layers_total,
-            steps: None,
+            steps: &sums.steps,
         }
     }
 
@@ -943,13 +933,7 @@ impl<'a> BodyWriter<'a> {
                     st.last_percent = percent;
                 }
             }
-            let (dt, e) = match self.steps {
-                Some(steps) => steps[i - 1],
-                None => (
-                    tp.points[i - 1].pos.distance(q.pos) / q.speed,
-                    segment_volume(self.design, tp, i) * self.e_per_mm3,
-                ),
-            };
+            let (dt, e) = self.steps[i - 1];
             st.t_done += dt;
             let (x, y, z, e) = Line::append(buf, |line| {
                 line.text(b"G1 X");
@@ -1127,6 +1111,14 @@ mod tests {
                 .map(|i| segment_volume(&d, tp, i))
                 .sum();
             assert_eq!(summary.volume_mm3.to_bits(), volume.to_bits());
+            // Each segment's time and E, as the body's writer adds them up.
+            for (i, &(dt, e)) in (1..).zip(&sums.steps) {
+                let (a, b) = (&tp.points[i - 1], &tp.points[i]);
+                assert_eq!(dt.to_bits(), (a.pos.distance(b.pos) / b.speed).to_bits());
+                let e_of = segment_volume(&d, tp, i) * e_per_mm3(&d.printer);
+                assert_eq!(e.to_bits(), e_of.to_bits());
+            }
+            assert_eq!(sums.steps.len(), tp.points.len() - 1);
             let z = |q: &crate::toolpath::PathPoint| q.pos.z;
             let top = tp.points.iter().map(z).fold(f64::MIN, f64::max);
             let bottom = tp.points.iter().map(z).fold(f64::MAX, f64::min);
@@ -1142,8 +1134,7 @@ mod tests {
     }
 
     /// The body written in rounds of chunks, on both cores, each from the state its chunk's
-    /// sums reach and with each segment's time and E from the sums, is the body formatted in
-    /// one piece on one, measuring them point by point: a path of more than a round of
+    /// sums reach, is the body formatted in one piece on one: a path of more than a round of
     /// chunks (the last short) whose speeds change, with and without host metadata and
     /// progress, in either E mode.
     #[test]
@@ -1184,24 +1175,13 @@ mod tests {
         ] {
             (d.printer.host_metadata, d.printer.progress) = (metadata, progress);
             d.printer.extrusion = extrusion;
-            // The chunks written with each segment's time and E from the path's sums (as the
-            // program is), the whole measured as it is written.
-            let measuring =
-                BodyWriter::new(&d, &tp, (tp.print_time(), 12_345.0), tp.layer_starts.len());
             let sums = PathSums::of(&d, &tp, None);
-            let body = BodyWriter {
-                steps: Some(&sums.steps),
-                ..measuring
-            };
+            let body = BodyWriter::new(&d, &tp, &sums, 12_345.0, tp.layer_starts.len());
             let (mut text, mut index) = (Vec::new(), Vec::new());
             crate::parallel::awake(|| {
                 body.write(&mut text, &mut Some(&mut index), &body.chunk_starts(&sums))
             })
             .unwrap();
-            let body = BodyWriter {
-                steps: None,
-                ..body
-            };
             let mut whole = Piece::default();
             let want = Wanted {
                 index: true,

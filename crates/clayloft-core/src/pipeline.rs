@@ -321,7 +321,17 @@ pub fn run_unjudged(design: &Design) -> Result<PrintJob, FieldError> {
 /// see [`crate::clay::wet_design`]).
 pub fn judge(design: &Design, job: &PrintJob) -> Option<Arc<crate::printability::Printability>> {
     let wet = crate::clay::wet_design(design).ok()?;
-    crate::printability::assess(&wet, &job.surface, &job.toolpath)
+    verdict(&wet, &job.surface, &job.toolpath)
+}
+
+/// The verdict on `toolpath` over `surface`, made for `wet` (a design at its wet size): `None`
+/// for a clay body that does not resolve. A session's verdict stage and [`judge`] both.
+pub(crate) fn verdict(
+    wet: &Design,
+    surface: &Surface,
+    toolpath: &Toolpath,
+) -> Option<Arc<crate::printability::Printability>> {
+    crate::printability::assess(wet, surface, toolpath)
         .ok()
         .map(Arc::new)
 }

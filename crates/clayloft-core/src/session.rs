@@ -877,9 +877,8 @@ fn finish_stages(
     };
     done.verdict = later.verdict.refresh(verdict_key, || {
         Ok(verdict
-            .then(|| crate::printability::assess(design, &surface, toolpath).ok())
-            .flatten()
-            .map(Arc::new))
+            .then(|| crate::pipeline::verdict(design, &surface, toolpath))
+            .flatten())
     })?;
     Ok(())
 }

@@ -163,6 +163,24 @@ impl<U> Path<'_, U> {
         }
         *from
     }
+
+    /// Chord `c`'s window where the heights rise along the block (chords counted from chord
+    /// `first`, `boxes` theirs so far): from the chord after the last one lying wholly a
+    /// layer's tolerance below it, and no farther back than `limits.reach` of path. `from`
+    /// holds the two answers for an earlier chord (both only move on).
+    fn rising_start(
+        &self,
+        first: usize,
+        c: usize,
+        boxes: &[ChordBox],
+        (height_from, length_from): &mut (usize, usize),
+    ) -> usize {
+        let below = boxes[c].lo.z - self.limits.same_layer;
+        while *height_from < c && boxes[*height_from].hi.z < below {
+            *height_from += 1;
+        }
+        (*height_from).max(self.length_start(first, c, length_from))
+    }
 }
 
 /// One block's loops (for each chord that closes one or more, the widest one's reach, mm),
@@ -256,7 +274,8 @@ impl Work {
         let mut winding = 0;
         // The last chords that do not go round the middle anticlockwise, and clockwise.
         let (mut not_ccw, mut not_cw) = (None, None);
-        let (mut height_from, mut length_from) = (0, 0);
+        // The last chord's window starts (by height, by length).
+        let mut starts_from = (0, 0);
         for c in 0..count {
             // The chord read: its box, direction, winding and way round.
             let (a, b) = chord(c);
@@ -297,11 +316,7 @@ impl Work {
             self.lows.push(c, |k| turn[k] >= turn[c]);
             // The window.
             let (start, flag_start) = if rising {
-                let below = bx.lo.z - limits.same_layer;
-                while height_from < c && self.boxes[height_from].hi.z < below {
-                    height_from += 1;
-                }
-                let start = height_from.max(path.length_start(first, c, &mut length_from));
+                let start = path.rising_start(first, c, &self.boxes, &mut starts_from);
                 (start, start)
             } else {
                 (self.starts[c], self.flag_starts[c])
@@ -459,7 +474,8 @@ impl Work {
         // The last chord's end: its point and its pseudo-angle.
         let mut last: Option<(usize, f64)> = None;
         let mut angle = 0.0;
-        let (mut height_from, mut length_from) = (0, 0);
+        // The last chord's window starts (by height, by length).
+        let mut starts_from = (0, 0);
         for c in 0..count {
             let (a, b) = chord(c);
             let bx = ChordBox::of(a, b);
@@ -490,11 +506,7 @@ impl Work {
             self.sweeps.push((from.min(angle), from.max(angle)));
             last = Some((chords[first + c].1, qb));
             // The window, as [`Work::judge`] finds it where the heights rise.
-            let below = bx.lo.z - limits.same_layer;
-            while height_from < c && self.boxes[height_from].hi.z < below {
-                height_from += 1;
-            }
-            let start = height_from.max(path.length_start(first, c, &mut length_from));
+            let start = path.rising_start(first, c, &self.boxes, &mut starts_from);
             // The chords up to c − 2 in the sliding extremes.
             if let Some(k) = c.checked_sub(2) {
                 let sweeps = &self.sweeps;
