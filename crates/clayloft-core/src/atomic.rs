@@ -105,11 +105,45 @@ pub struct Output<'a> {
 }
 
 impl<'a> Output<'a> {
-    /// The file written, for [`start_writeback`] (from another thread, say, while this writer
-    /// goes on).
+    /// The file written, for [`start_writeback`] and [`write_at`] (from other threads, say,
+    /// while this writer waits; [`Write::flush`] it first, so that the file holds what was
+    /// written before).
     pub fn file(&self) -> &'a std::fs::File {
         self.writer.get_ref()
     }
+
+    /// Goes on writing at byte `offset` of the file (after text put in place up to there with
+    /// [`write_at`]).
+    pub fn continue_at(&mut self, offset: u64) -> std::io::Result<()> {
+        use std::io::Seek;
+        self.writer
+            .seek(std::io::SeekFrom::Start(offset))
+            .map(|_| ())
+    }
+}
+
+/// Writes `bytes` at byte `offset` of `file`, whatever the file's own position: threads may
+/// each write their parts of a file at once.
+#[cfg(unix)]
+pub fn write_at(file: &std::fs::File, bytes: &[u8], offset: u64) -> std::io::Result<()> {
+    std::os::unix::fs::FileExt::write_all_at(file, bytes, offset)
+}
+
+/// Writes `bytes` at byte `offset` of `file` (Windows also moves the file's position).
+#[cfg(windows)]
+pub fn write_at(file: &std::fs::File, mut bytes: &[u8], mut offset: u64) -> std::io::Result<()> {
+    while !bytes.is_empty() {
+        match std::os::windows::fs::FileExt::seek_write(file, bytes, offset) {
+            Ok(0) => return Err(std::io::ErrorKind::WriteZero.into()),
+            Ok(n) => {
+                bytes = &bytes[n..];
+                offset += n as u64;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
 }
 
 impl Write for Output<'_> {

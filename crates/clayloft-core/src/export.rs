@@ -23,7 +23,7 @@ use crate::check::{
     Violation,
 };
 use crate::design::Design;
-use crate::gcode::{JobSummary, ProgramOut, write_program_to};
+use crate::gcode::{JobSummary, PieceSink, ProgramOut, write_program_to};
 use crate::pipeline::PrintJob;
 
 /// A G-code file in place: the header's figures, and the file it replaced (see [`Replaced`]:
@@ -154,11 +154,12 @@ fn refusal(design: &Design, report: Option<&CheckReport>) -> Option<ExportError>
 }
 
 /// Writes to the output file and to the self-check, which takes the body's moves as the writer
-/// tells them (the text they read as, tested) and reads the rest of the text. A round of the
-/// body's pieces goes to the file on a second core while this one resolves their moves (the
-/// file's write is the kernel's copy of the text, which had the other core idle) and starts
-/// the rounds before it for the disk (see [`crate::atomic::start_writeback`]: the write is the
-/// longer of the two, by about a tenth of a millisecond a round on the benchmark vase).
+/// tells them (the text they read as, tested) and reads the rest of the text. Each piece of the
+/// body goes to its place in the file, and its moves to the self-check, from the core that
+/// formatted it, as soon as it is formatted ([`FileSink`]); where the self-check cannot take
+/// pieces so (a line cut before the body), a round of pieces goes to the file on a second
+/// core while this one reads it. The text written is started for the disk a megabyte at a
+/// time (see [`crate::atomic::start_writeback`]).
 struct Tee<'a, 'f> {
     file: &'a mut crate::atomic::Output<'f>,
     verifier: &'a mut GcodeVerifier,
@@ -195,6 +196,71 @@ impl ProgramOut for Tee<'_, '_> {
         self.started = self.written;
         self.written += pieces.iter().map(|p| p.text.len() as u64).sum::<u64>();
         written
+    }
+
+    fn with_sink(
+        &mut self,
+        moves: usize,
+        body: &mut dyn FnMut(&dyn PieceSink) -> std::io::Result<()>,
+    ) -> Option<std::io::Result<()>> {
+        // The text before the body is in the file; each piece goes after it, at its place.
+        if let Err(e) = self.file.flush() {
+            return Some(Err(e));
+        }
+        let file = self.file.file();
+        let started = std::sync::atomic::AtomicU64::new(self.started);
+        let mut outcome = Ok(());
+        let end = self.verifier.stream_told(self.written, moves, |stream| {
+            let sink = FileSink {
+                stream,
+                file,
+                started: &started,
+            };
+            outcome = body(&sink);
+        })?;
+        let outcome = outcome.and_then(|()| self.file.continue_at(end));
+        self.started = started.into_inner();
+        self.written = end;
+        Some(outcome)
+    }
+}
+
+/// The body's pieces, each written to its place in the file and resolved by the self-check on
+/// the core that formatted it ([`crate::check::ToldStream`]).
+struct FileSink<'s, 'r> {
+    stream: &'s crate::check::ToldStream<'r>,
+    file: &'s std::fs::File,
+    /// Where the text not yet started for the disk begins.
+    started: &'s std::sync::atomic::AtomicU64,
+}
+
+/// Bytes of the body started for the disk at a time ([`crate::atomic::start_writeback`]):
+/// about a round of the writer's pieces, so that little is left to write at the rename.
+const WRITEBACK_BYTES: u64 = 1 << 20;
+
+impl PieceSink for FileSink<'_, '_> {
+    fn take(&self, k: usize, piece: &crate::check::ToldPiece<'_>) -> std::io::Result<()> {
+        let mut result = Ok(());
+        self.stream.take(k, piece, |offset| {
+            result = crate::atomic::write_at(self.file, piece.text, offset);
+            // The text before this piece is placed (and mostly written): started for the disk
+            // once a megabyte of it waits.
+            use std::sync::atomic::Ordering;
+            let from = self.started.load(Ordering::Relaxed);
+            if offset >= from + WRITEBACK_BYTES
+                && self
+                    .started
+                    .compare_exchange(from, offset, Ordering::Relaxed, Ordering::Relaxed)
+                    .is_ok()
+            {
+                crate::atomic::start_writeback(self.file, from..offset);
+            }
+        });
+        result
+    }
+
+    fn abandon(&self) {
+        self.stream.abandon();
     }
 }
 

@@ -39,6 +39,28 @@ pub(crate) trait ProgramOut {
     fn body(&mut self, pieces: &[crate::check::ToldPiece<'_>]) -> io::Result<()> {
         pieces.iter().try_for_each(|p| self.text(p.text))
     }
+
+    /// Runs `body` with a sink that takes the body's pieces as they are formatted, on the
+    /// threads that format them, where this output has one (`moves`: how many moves the
+    /// pieces hold); none, with `body` not run, where the pieces must come in order through
+    /// [`ProgramOut::body`].
+    fn with_sink(
+        &mut self,
+        moves: usize,
+        body: &mut dyn FnMut(&dyn PieceSink) -> io::Result<()>,
+    ) -> Option<io::Result<()>> {
+        let _ = (moves, body);
+        None
+    }
+}
+
+/// Where the body's pieces go as they are formatted ([`ProgramOut::with_sink`]).
+pub(crate) trait PieceSink: Sync {
+    /// Takes piece `k` of the body, once it waits for the pieces before it to be placed: each
+    /// of 0, 1, 2 … once, from any thread, a thread that takes several taking them in order.
+    fn take(&self, k: usize, piece: &crate::check::ToldPiece<'_>) -> io::Result<()>;
+    /// Stops every wait for a piece: some piece will never come.
+    fn abandon(&self);
 }
 
 impl<W: Write + ?Sized> ProgramOut for W {
@@ -603,7 +625,9 @@ fn write_program_indexed(
 const BODY_CHUNK: usize = 4 * 1024;
 
 /// Chunks formatted at a time, shared out over the cores as they get free (a core slowed by
-/// another thread on it takes fewer): four a core of this machine. A round's last chunks leave
+/// another thread on it takes fewer), for an output that takes the body in rounds (an output
+/// with a [`PieceSink`], `clayloft gcode`'s, takes each chunk as it is formatted): four a core
+/// of this machine. A round's last chunks leave
 /// a core idle while the other finishes; rounds of eight chunks of 4 Ki points left the helper
 /// idle beside the formatting a quarter as long as rounds of four of 8 Ki points (0.4 against
 /// 1.6 ms a run of the benchmark vase, `perf record`, 30 runs, 2026-12-06).
@@ -800,6 +824,31 @@ impl<'a> BodyWriter<'a> {
             moves: out.wants_moves(),
         };
         let chunk = |k: usize| 1 + k * BODY_CHUNK..(1 + (k + 1) * BODY_CHUNK).min(n);
+        // Each chunk goes from the core that formats it to its place, where the output can
+        // take it so (and no line index is kept): no rounds, no core reading another's text.
+        if !want.index {
+            let streamed = out.with_sink(n - 1, &mut |sink| {
+                let written =
+                    crate::parallel::map_shared(starts.len(), Piece::default, |piece, k| {
+                        // A panic here leaves piece k untaken: the other cores stop waiting for it.
+                        struct Abandon<'s>(&'s dyn PieceSink);
+                        impl Drop for Abandon<'_> {
+                            fn drop(&mut self) {
+                                if std::thread::panicking() {
+                                    self.0.abandon();
+                                }
+                            }
+                        }
+                        let _abandon = Abandon(sink);
+                        self.format(chunk(k), starts[k], want, piece);
+                        sink.take(k, &piece.told())
+                    });
+                written.into_iter().collect()
+            });
+            if let Some(result) = streamed {
+                return result;
+            }
+        }
         // A round's pieces, reused round after round.
         let mut pieces: Vec<std::sync::Mutex<Piece>> = (0..ROUND_CHUNKS)
             .map(|_| std::sync::Mutex::new(Piece::default()))
@@ -818,14 +867,7 @@ impl<'a> BodyWriter<'a> {
                 .iter_mut()
                 .map(|p| &*p.get_mut().unwrap_or_else(|e| e.into_inner()))
                 .collect();
-            let told: Vec<_> = used
-                .iter()
-                .map(|p| crate::check::ToldPiece {
-                    text: &p.text,
-                    moves: p.told.then_some(&p.moves[..]),
-                    lines: p.lines,
-                })
-                .collect();
+            let told: Vec<_> = used.iter().map(|p| p.told()).collect();
             out.body(&told)?;
             if let Some(v) = index.as_deref_mut() {
                 used.iter().for_each(|p| v.extend_from_slice(&p.points));
@@ -1026,6 +1068,15 @@ struct Piece {
 }
 
 impl Piece {
+    /// The piece as the self-check takes it.
+    fn told(&self) -> crate::check::ToldPiece<'_> {
+        crate::check::ToldPiece {
+            text: &self.text,
+            moves: self.told.then_some(&self.moves[..]),
+            lines: self.lines,
+        }
+    }
+
     /// Emptied for a chunk of `points` path points.
     fn clear(&mut self, points: usize) {
         self.text.clear();

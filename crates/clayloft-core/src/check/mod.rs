@@ -28,8 +28,8 @@ use glam::DVec3;
 
 pub use limits::{Limits, LimitsError};
 use moves::MoveReader;
-pub(crate) use moves::ToldPiece;
 pub use moves::{GcodeError, Move, parse_moves};
+pub(crate) use moves::{ToldPiece, ToldStream};
 use report::Tally;
 pub use report::{
     COLLISION, CROSSING, CheckReport, NOT_CONTINUOUS, NOT_MEASURED, OUTSIDE, OVERHANG, PathEvent,
@@ -76,6 +76,19 @@ impl GcodeVerifier {
     /// the text of those it does not: what the G-code writer gives for the path's body.
     pub(crate) fn feed_told(&mut self, pieces: &[ToldPiece<'_>]) {
         self.reader.feed_told(pieces);
+    }
+
+    /// Takes pieces of the program's body as they are written, on the threads that write them
+    /// (see `ToldStream`): the first piece's text at byte `text_at` of the file, `moves` moves
+    /// in all. Gives where the last piece's text ends; none, with `run` not run, where the
+    /// pieces must come in order through [`GcodeVerifier::feed_told`].
+    pub(crate) fn stream_told(
+        &mut self,
+        text_at: u64,
+        moves: usize,
+        run: impl FnOnce(&ToldStream<'_>),
+    ) -> Option<u64> {
+        self.reader.stream_told(text_at, moves, run)
     }
 
     /// [`verify_gcode`]'s verdict on the text written.

@@ -161,6 +161,61 @@ impl MoveReader {
         }
     }
 
+    /// Takes the pieces `run` gives to a [`ToldStream`] (on several threads, as each is
+    /// written: see there) as [`MoveReader::feed_told`] would take them in order; `text_at`
+    /// says where in the file the first piece's text goes and `moves` how many moves the pieces
+    /// hold (room for more is not made: a piece that does not fit is an error). Gives where the
+    /// last piece's text ends; none, with `run` not run, where a line cut by the text before
+    /// waits for the first piece, or reading has stopped at an error.
+    pub(crate) fn stream_told(
+        &mut self,
+        text_at: u64,
+        moves: usize,
+        run: impl FnOnce(&ToldStream<'_>),
+    ) -> Option<u64> {
+        if self.error.is_some() || !self.partial.is_empty() {
+            return None;
+        }
+        self.moves.reserve(moves);
+        let len = self.moves.len();
+        let stream = ToldStream {
+            chain: std::sync::Mutex::new(Chain {
+                next: 0,
+                state: self.state,
+                lines: self.lines,
+                text_at,
+                room: &mut self.moves.spare_capacity_mut()[..moves],
+            }),
+            abandoned: std::sync::atomic::AtomicBool::new(false),
+            resolved: std::sync::Mutex::new(Vec::new()),
+        };
+        run(&stream);
+        let chain = stream.chain.into_inner().unwrap_or_else(|e| e.into_inner());
+        let (state, lines, text_end) = (chain.state, chain.lines, chain.text_at);
+        let mut resolved = stream
+            .resolved
+            .into_inner()
+            .unwrap_or_else(|e| e.into_inner());
+        resolved.sort_unstable_by_key(|r| r.0);
+        // The moves of the pieces in order up to the first that failed (or was never taken):
+        // each before it wrote its whole stretch, that one the first `written` of its own.
+        let mut written_total = 0;
+        for (expected, (k, written, result)) in resolved.into_iter().enumerate() {
+            if k != expected {
+                break;
+            }
+            written_total += written;
+            if let Err(e) = result {
+                self.error = Some(e);
+                break;
+            }
+        }
+        // SAFETY: `written_total` contiguous moves from `len` on were initialised (above).
+        unsafe { self.moves.set_len(len + written_total) };
+        (self.state, self.lines) = (state, lines);
+        Some(text_end)
+    }
+
     /// The moves and where the first starts, once the whole text is in.
     pub fn finish(mut self) -> Result<(Vec<Move>, DVec3), GcodeError> {
         let rest = std::mem::take(&mut self.partial);
@@ -210,6 +265,135 @@ pub(crate) struct ToldPiece<'a> {
     pub text: &'a [u8],
     pub moves: Option<&'a [Move]>,
     pub lines: usize,
+}
+
+/// The body's pieces taken as they are written, on the threads that wrote them
+/// ([`MoveReader::stream_told`]). A thread that has written piece k into a buffer of its own
+/// gives it to [`ToldStream::take`], which places it after the pieces before it (the file
+/// offset of its text, its first line, the state it starts from, its stretch of the moves) and
+/// resolves its moves there, on that thread: each core reads what it wrote, from its own cache,
+/// and writes the next piece into the same buffer with no other core holding those lines. Two
+/// cores that share no cache (a virtual machine's, placed on different processor dies) pass a
+/// line written by one to the other at several times the cost of a read from memory: with one
+/// core writing the whole text to the file and the other resolving all the moves, the next
+/// round's formatting took three times as long.
+pub(crate) struct ToldStream<'r> {
+    /// Where the next piece goes; only piece `next` may be placed.
+    chain: std::sync::Mutex<Chain<'r>>,
+    /// Set when some piece will never be taken (its writer failed): the others stop waiting.
+    abandoned: std::sync::atomic::AtomicBool,
+    /// Each piece taken: how many of its moves were resolved, and its first error.
+    resolved: std::sync::Mutex<Vec<Resolved>>,
+}
+
+/// A piece taken by a [`ToldStream`]: its number, how many of its moves were resolved, and its
+/// first error.
+type Resolved = (usize, usize, Result<(), GcodeError>);
+
+/// Where the pieces placed so far end.
+struct Chain<'r> {
+    /// The next piece to place.
+    next: usize,
+    /// The modal state after them, their lines, and where the next piece's text goes.
+    state: State,
+    lines: usize,
+    text_at: u64,
+    /// Room for the next pieces' moves.
+    room: &'r mut [std::mem::MaybeUninit<Move>],
+}
+
+impl ToldStream<'_> {
+    /// Takes piece `k` (each of 0, 1, 2 … once, from any thread; a thread that takes several
+    /// takes them in order, as it must not wait for one it will take later): waits until the
+    /// pieces before it are placed, places it, has `write(offset)` put its text at that
+    /// file offset and resolves its moves into their place. A piece that does not tell its
+    /// moves is read here.
+    pub(crate) fn take(&self, k: usize, piece: &ToldPiece<'_>, write: impl FnOnce(u64)) {
+        use std::sync::atomic::Ordering;
+        let part = match piece.moves {
+            Some(moves) => Part {
+                moves: Cow::Borrowed(moves),
+                modal: Vec::new(),
+                error: None,
+                lines: piece.lines,
+            },
+            None => match std::str::from_utf8(piece.text) {
+                Ok(text) => read_part(text),
+                Err(_) => Part {
+                    moves: Cow::Borrowed(&[]),
+                    modal: Vec::new(),
+                    error: Some(GcodeError {
+                        line: 1,
+                        message: "not text (UTF-8)".into(),
+                    }),
+                    lines: piece.lines,
+                },
+            },
+        };
+        let mut spins = 0u32;
+        let mut chain = loop {
+            let chain = self.chain.lock().unwrap_or_else(|e| e.into_inner());
+            if chain.next == k {
+                break chain;
+            }
+            drop(chain);
+            if self.abandoned.load(Ordering::Relaxed) {
+                return;
+            }
+            // The piece before is being written on another core: a few microseconds mostly.
+            spins = spins.wrapping_add(1);
+            if spins.is_multiple_of(64) {
+                std::thread::yield_now();
+            } else {
+                std::hint::spin_loop();
+            }
+        };
+        let (start, first_line, offset) = (chain.state, chain.lines, chain.text_at);
+        let room = std::mem::take(&mut chain.room);
+        let fits = part.moves.len() <= room.len();
+        let (stretch, rest) = room.split_at_mut(part.moves.len().min(room.len()));
+        chain.room = rest;
+        chain.next += 1;
+        chain.lines += part.lines;
+        chain.text_at += piece.text.len() as u64;
+        let mut end = start;
+        let outcome = match part.state_after(&start) {
+            _ if !fits => {
+                drop(chain);
+                write(offset);
+                let error = GcodeError {
+                    line: first_line + 1,
+                    message: "more moves than the writer said".into(),
+                };
+                (0, Err(error))
+            }
+            // Told from the raw moves: the next piece may be placed while this one resolves.
+            Some(after) => {
+                chain.state = after;
+                drop(chain);
+                write(offset);
+                part.resolve_into(&mut end, first_line, stretch)
+            }
+            // A mode changes within it (or positions are relative): resolved in turn.
+            None => {
+                let resolved = part.resolve_into(&mut end, first_line, stretch);
+                chain.state = end;
+                drop(chain);
+                write(offset);
+                resolved
+            }
+        };
+        self.resolved
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((k, outcome.0, outcome.1));
+    }
+
+    /// Stops every wait for a piece: some piece will never be taken.
+    pub(crate) fn abandon(&self) {
+        self.abandoned
+            .store(true, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 /// What changes the modal state, read from one line.
@@ -850,9 +1034,64 @@ mod tests {
     /// A program written with its body's moves told (as `clayloft gcode` hands them to its
     /// self-check) reads as its text: the same moves, ends, E and lines, to the bit, on a
     /// corner-origin and centre-origin printer, Klipper's dialect, absolute E, with the hosts'
-    /// layer and progress lines and without, over several rounds of the writer's pieces.
+    /// layer and progress lines and without, over several rounds of the writer's pieces; and
+    /// so does one whose pieces are streamed as they are formatted on both cores (each placed
+    /// in the text at the offset the stream gives), its text the same byte for byte.
     #[test]
     fn a_body_told_by_its_writer_reads_as_its_text() {
+        struct Streaming {
+            text: Vec<u8>,
+            reader: MoveReader,
+            streamed: bool,
+        }
+        impl crate::gcode::ProgramOut for Streaming {
+            fn text(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+                self.text.extend_from_slice(bytes);
+                self.reader.feed(bytes);
+                Ok(())
+            }
+            fn wants_moves(&self) -> bool {
+                true
+            }
+            fn with_sink(
+                &mut self,
+                moves: usize,
+                body: &mut dyn FnMut(&dyn crate::gcode::PieceSink) -> std::io::Result<()>,
+            ) -> Option<std::io::Result<()>> {
+                struct Sink<'s, 'r> {
+                    stream: &'s ToldStream<'r>,
+                    text: &'s std::sync::Mutex<Vec<u8>>,
+                }
+                impl crate::gcode::PieceSink for Sink<'_, '_> {
+                    fn take(&self, k: usize, piece: &ToldPiece<'_>) -> std::io::Result<()> {
+                        self.stream.take(k, piece, |at| {
+                            let mut text = self.text.lock().unwrap();
+                            let (at, end) = (at as usize, at as usize + piece.text.len());
+                            let len = text.len().max(end);
+                            text.resize(len, 0);
+                            text[at..end].copy_from_slice(piece.text);
+                        });
+                        Ok(())
+                    }
+                    fn abandon(&self) {
+                        self.stream.abandon();
+                    }
+                }
+                let at = self.text.len() as u64;
+                let text = std::sync::Mutex::new(std::mem::take(&mut self.text));
+                let mut outcome = Ok(());
+                let end = self.reader.stream_told(at, moves, |stream| {
+                    outcome = body(&Sink {
+                        stream,
+                        text: &text,
+                    });
+                });
+                self.text = text.into_inner().unwrap();
+                assert_eq!(end, Some(self.text.len() as u64));
+                self.streamed = true;
+                Some(outcome)
+            }
+        }
         struct Recording {
             text: Vec<u8>,
             reader: MoveReader,
@@ -909,7 +1148,85 @@ mod tests {
             for (t, r) in told.iter().zip(&read) {
                 assert_eq!(bits(t), bits(r), "{printer}: line {}", r.line);
             }
+            let mut streaming = Streaming {
+                text: Vec::new(),
+                reader: MoveReader::with_capacity(0),
+                streamed: false,
+            };
+            crate::gcode::write_program_to(&design, &job, &mut streaming).unwrap();
+            assert!(
+                streaming.streamed && streaming.text == out.text,
+                "{printer}"
+            );
+            let (told, told_start) = streaming.reader.finish().unwrap();
+            assert_eq!((told.len(), told_start), (read.len(), read_start));
+            for (t, r) in told.iter().zip(&read) {
+                assert_eq!(bits(t), bits(r), "{printer}: streamed, line {}", r.line);
+            }
         }
+    }
+
+    /// Pieces taken by a stream, each on a thread of its own, started last piece first: the
+    /// moves, lines and state of feeding the text in order, each piece's text placed after the
+    /// text before it, with pieces not told (read here) and pieces that change a mode among
+    /// them; and the first error where a piece has one.
+    #[test]
+    fn a_stream_of_pieces_reads_as_their_text() {
+        let head = "G90\nM83\nG1 X0 Y2 Z0.5\n";
+        let pieces = [
+            (
+                "G1 X1 Y2 Z0.5 E0.1\nM117 Layer 2\nG1 X2 Y2 Z0.5 E0.1\n",
+                true,
+            ),
+            ("G91\nG1 X1 E0.1\nG90\n", false),
+            ("G1 X3 Y2 Z1 E0.1\n", true),
+            ("G92 E0\nG1 X4 Y2 Z1 E0.2\nM82\nG1 X5 E0.4\n", false),
+            ("G1 X6 Y3 Z1 E0.5\n", true),
+        ];
+        let stream = |pieces: &[(&str, bool)]| {
+            let text: String = std::iter::once(head)
+                .chain(pieces.iter().map(|p| p.0))
+                .collect();
+            let mut reader = MoveReader::with_capacity(0);
+            reader.feed(head.as_bytes());
+            let raw: Vec<Part<'static>> = pieces.iter().map(|p| read_part(p.0)).collect();
+            let count = raw.iter().map(|p| p.moves.len()).sum();
+            let placed = std::sync::Mutex::new(Vec::new());
+            let end = reader.stream_told(head.len() as u64, count, |s| {
+                std::thread::scope(|scope| {
+                    for (k, (piece, told)) in pieces.iter().enumerate().rev() {
+                        let (raw, placed) = (&raw[k], &placed);
+                        scope.spawn(move || {
+                            let piece = ToldPiece {
+                                text: piece.as_bytes(),
+                                moves: told.then_some(&raw.moves[..]),
+                                lines: piece.lines().count(),
+                            };
+                            s.take(k, &piece, |at| placed.lock().unwrap().push((k, at)));
+                        });
+                    }
+                });
+            });
+            let mut placed = placed.into_inner().unwrap();
+            placed.sort_unstable();
+            (text, reader, end, placed)
+        };
+        let (text, reader, end, placed) = stream(&pieces);
+        assert_eq!(end, Some(text.len() as u64));
+        let mut at = head.len() as u64;
+        for (k, (piece, _)) in pieces.iter().enumerate() {
+            assert_eq!(placed[k], (k, at));
+            at += piece.len() as u64;
+        }
+        let lines = reader.lines;
+        assert_eq!(reader.finish(), parse_moves(&text));
+        assert_eq!(lines, text.lines().count());
+        // A piece that cannot be read: the first error, as reading the text gives it.
+        let mut broken = pieces;
+        broken[3].0 = "G1 X4 Y2 Z1 E0.2\nG1 X1e999\n";
+        let (text, reader, _, _) = stream(&broken);
+        let error = parse_moves(&text).expect_err("broken");
+        assert_eq!(reader.finish().expect_err("broken"), error);
     }
 
     /// Pieces not told, or told while a cut line waits, are read as text: the same moves as
