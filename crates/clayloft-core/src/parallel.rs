@@ -9,7 +9,8 @@
 //! sleeps, and inside [`awake`] (a session update, a whole command) it spins until the end: a
 //! part handed over starts within a microsecond. A part is handed to a free helper or, when
 //! none is free (a part started from a part, or two threads at once), run on the calling thread:
-//! the cores are busy then anyway.
+//! the cores are busy then anyway. A part the helper has not started by the time the calling
+//! thread waits for it is taken back and run there (the helper may be faulting pages in).
 
 use std::any::Any;
 use std::ops::Range;
@@ -162,7 +163,26 @@ struct Handed {
 }
 
 impl Handed {
-    fn finish(&mut self) -> Option<Box<dyn Any + Send>> {
+    /// Waits for the part and frees the helper, giving the part's panic. A part the helper has
+    /// not started yet is taken back and run here when `run_here` (else dropped unrun: this
+    /// thread is unwinding): the helper may be in the middle of something long (a huge page it
+    /// faults in while idle, a millisecond or more when the host must find the memory), and this
+    /// thread has nothing left to do but wait.
+    fn finish(&mut self, run_here: bool) -> Option<Box<dyn Any + Send>> {
+        if self.helper.posted.swap(false, Ordering::Acquire) {
+            let part = self
+                .helper
+                .part
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take();
+            // The helper is free again (for the part's own parallel work, say).
+            self.waited = true;
+            self.helper.claimed.store(false, Ordering::Release);
+            return part
+                .filter(|_| run_here)
+                .and_then(|part| std::panic::catch_unwind(AssertUnwindSafe(part)).err());
+        }
         let started = Instant::now();
         let mut spins = 0u32;
         while !self.helper.done.load(Ordering::Acquire) {
@@ -187,7 +207,7 @@ impl Handed {
 
     /// Waits for the part; its panic goes on here.
     fn wait(mut self) {
-        if let Some(panic) = self.finish() {
+        if let Some(panic) = self.finish(true) {
             std::panic::resume_unwind(panic);
         }
     }
@@ -196,8 +216,9 @@ impl Handed {
 impl Drop for Handed {
     fn drop(&mut self) {
         if !self.waited {
-            // Unwinding from the caller's own part: wait, and let the caller's panic go on.
-            let _ = self.finish();
+            // Unwinding from the caller's own part: wait (a part not started is dropped unrun),
+            // and let the caller's panic go on; or left unjoined: it runs, here if not started.
+            let _ = self.finish(!std::thread::panicking());
         }
     }
 }
@@ -548,8 +569,9 @@ pub fn both<A: Send, B>(
     (out_a.expect("the helper ran a"), b)
 }
 
-/// [`both`] where a helper is free: `a` on it while `b` runs here; `None`, with neither run,
-/// where none is (for work split in a way that costs more than the whole on one core).
+/// [`both`] where a helper is free: `a` on it while `b` runs here (or here after `b`, where the
+/// helper has not started it by then); `None`, with neither run, where none is (for work split
+/// in a way that costs more than the whole on one core).
 pub fn try_both<A: Send, B>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B) -> Option<(A, B)> {
     let helper = Helper::claim()?;
     let mut out_a = None;
@@ -800,17 +822,17 @@ mod tests {
         }
     }
 
-    /// Two parts tried together run both, the first on a helper, or neither (no helper free:
-    /// other tests may hold it); seen both ways, the second from inside a part that holds every
-    /// helper there is.
+    /// Two parts tried together run both, the first on a helper (or taken back by this thread),
+    /// or neither (no helper free: other tests may hold it); seen both ways, the second from
+    /// inside a part that holds every helper there is.
     #[test]
-    fn parts_tried_together_run_on_two_threads_or_not_at_all() {
+    fn parts_tried_together_run_both_or_not_at_all() {
         let try_once = || {
             let ran = AtomicUsize::new(0);
             let out = try_both(
                 || {
                     ran.fetch_add(1, Ordering::Relaxed);
-                    std::thread::current().id()
+                    1
                 },
                 || {
                     ran.fetch_add(1, Ordering::Relaxed);
@@ -818,9 +840,8 @@ mod tests {
                 },
             );
             match out {
-                Some((there, b)) => {
-                    assert_ne!(there, std::thread::current().id());
-                    assert_eq!((b, ran.load(Ordering::Relaxed)), (7, 2));
+                Some((a, b)) => {
+                    assert_eq!((a, b, ran.load(Ordering::Relaxed)), (1, 7, 2));
                     true
                 }
                 None => {
@@ -843,6 +864,38 @@ mod tests {
         }
         held.iter()
             .for_each(|h| h.claimed.store(false, Ordering::Release));
+    }
+
+    /// A part handed to a helper that has not started it when the caller waits (here a helper
+    /// with no thread: it never will) is taken back and run by the caller, its panic going on
+    /// there; one dropped while the caller unwinds is dropped unrun; and the helper is free
+    /// again either way.
+    #[test]
+    fn a_part_not_started_is_taken_back() {
+        let idle: &'static Helper = Box::leak(Box::new(Helper {
+            claimed: AtomicBool::new(true),
+            posted: AtomicBool::new(false),
+            part: Mutex::new(None),
+            done: AtomicBool::new(false),
+            panic: Mutex::new(None),
+            thread: OnceLock::new(),
+        }));
+        let mut ran_on = None;
+        idle.hand(Box::new(|| ran_on = Some(std::thread::current().id())))
+            .wait();
+        assert_eq!(ran_on, Some(std::thread::current().id()));
+        assert!(!idle.claimed.load(Ordering::Acquire));
+        idle.claimed.store(true, Ordering::Release);
+        let failed = idle.hand(Box::new(|| panic!("taken back")));
+        assert!(std::panic::catch_unwind(AssertUnwindSafe(|| failed.wait())).is_err());
+        idle.claimed.store(true, Ordering::Release);
+        let ran = AtomicBool::new(false);
+        let unwound = std::panic::catch_unwind(AssertUnwindSafe(|| {
+            let _handed = idle.hand(Box::new(|| ran.store(true, Ordering::Relaxed)));
+            panic!("the caller's own part");
+        }));
+        assert!(unwound.is_err() && !ran.load(Ordering::Relaxed));
+        assert!(!idle.claimed.load(Ordering::Acquire));
     }
 
     /// Work started beside the caller gives its result on joining, whether a helper took it
