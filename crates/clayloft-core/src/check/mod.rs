@@ -40,7 +40,7 @@ pub use report::{
 pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeError> {
     validate(limits)?;
     let (moves, start) = parse_moves(text)?;
-    check_moves(&moves, start, limits, false).map(|(report, _)| report)
+    check_moves(moves, start, limits, false).map(Option::unwrap_or_default)
 }
 
 /// Whether a G-code program keeps `limits`: `Ok(None)` when it does, shown without measuring
@@ -53,7 +53,7 @@ pub fn check_gcode(text: &str, limits: &Limits) -> Result<CheckReport, GcodeErro
 pub fn verify_gcode(text: &str, limits: &Limits) -> Result<Option<CheckReport>, GcodeError> {
     validate(limits)?;
     let (moves, start) = parse_moves(text)?;
-    verify_moves(&moves, start, limits)
+    check_moves(moves, start, limits, true)
 }
 
 /// [`verify_gcode`] of a program as it is written: the text goes in through
@@ -95,7 +95,7 @@ impl GcodeVerifier {
     pub fn finish(self, limits: &Limits) -> Result<Option<CheckReport>, GcodeError> {
         validate(limits)?;
         let (moves, start) = self.reader.finish()?;
-        verify_moves(&moves, start, limits)
+        check_moves(moves, start, limits, true)
     }
 }
 
@@ -110,23 +110,6 @@ impl std::io::Write for GcodeVerifier {
     }
 }
 
-/// [`verify_gcode`] of moves read already.
-fn verify_moves(
-    moves: &[Move],
-    start: DVec3,
-    limits: &Limits,
-) -> Result<Option<CheckReport>, GcodeError> {
-    let (report, shown) = check_moves(moves, start, limits, true)?;
-    match (shown, report.violations.is_empty()) {
-        (true, true) => Ok(None),
-        // Not shown: the layers were measured in full after all, and this is the report.
-        (false, _) => Ok(Some(report)),
-        // The layers shown, another limit broken (the bed, the holder): measured again for the
-        // layers' figures of the report.
-        (true, false) => check_moves(moves, start, limits, false).map(|(r, _)| Some(r)),
-    }
-}
-
 /// The limits, or why they cannot be checked against (as an error of the program's first line).
 fn validate(limits: &Limits) -> Result<(), GcodeError> {
     limits.validate().map_err(|e| GcodeError {
@@ -136,15 +119,16 @@ fn validate(limits: &Limits) -> Result<(), GcodeError> {
 }
 
 /// [`check_gcode`] of moves read already (`start`: where the first begins), in the file's
-/// coordinates; with `show`, the layers are first shown to hold by witnesses (see
-/// [`verify_gcode`]), and the second value says whether they were (the report then lacks the
-/// layers' figures).
+/// coordinates, always a report; with `show`, [`verify_gcode`]'s verdict: the layers first
+/// shown to hold by witnesses, and no report where they are and nothing else breaks. The moves
+/// are let go once the path is copied from them (the layer search's buffers reuse their 9 MB
+/// on the benchmark vase, whose `clayloft gcode` then fills four huge pages fewer).
 fn check_moves(
-    moves: &[Move],
+    moves: Vec<Move>,
     start: DVec3,
     limits: &Limits,
     show: bool,
-) -> Result<(CheckReport, bool), GcodeError> {
+) -> Result<Option<CheckReport>, GcodeError> {
     // Into the bed frame: the file's coordinates are the printer's own.
     let [ox, oy] = limits.origin_offset();
     let shift = DVec3::new(ox, oy, 0.0);
@@ -162,17 +146,26 @@ fn check_moves(
     let first_ext = moves.iter().position(|m| m.de > 0.0);
     let last_ext = moves.iter().rposition(|m| m.de > 0.0);
     let extruding = first_ext.zip(last_ext);
-    let tally = |range| MoveTally::of(moves, range, start, limits, extruding);
-    let (path, tallied) = extruding_path(moves, start, shift, extruding, limits, tally);
+    let tally = |range| MoveTally::of(&moves, range, start, limits, extruding);
+    let (path, tallied) = extruding_path(&moves, start, shift, extruding, limits, tally);
+    drop(moves);
     tallied.into_report(limits, &mut report);
-    if let Some(((vertices, lines), clearance)) = path {
-        if show {
-            let shown = layers::layers_hold(&vertices, &lines, limits, &mut report, clearance);
-            return Ok((report, shown));
+    let Some(((vertices, lines), clearance)) = path else {
+        return Ok((!show || !report.violations.is_empty()).then_some(report));
+    };
+    if show {
+        let before = report.clone();
+        match layers::layers_hold(&vertices, &lines, limits, &mut report, clearance) {
+            true if report.violations.is_empty() => return Ok(None),
+            // Not shown: the layers were measured in full after all, and this is the report.
+            false => return Ok(Some(report)),
+            // The layers shown, another limit broken (the bed, the holder): measured in full
+            // for the layers' figures of the report.
+            true => report = before,
         }
-        layers::measure_layers(&vertices, &lines, limits, &mut report);
     }
-    Ok((report, show))
+    layers::measure_layers(&vertices, &lines, limits, &mut report);
+    Ok(Some(report))
 }
 
 /// The points of an extruding path in the bed frame, and each one's G-code line.
