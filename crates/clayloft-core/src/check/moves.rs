@@ -1039,63 +1039,14 @@ mod tests {
     /// in the text at the offset the stream gives), its text the same byte for byte.
     #[test]
     fn a_body_told_by_its_writer_reads_as_its_text() {
-        struct Streaming {
-            text: Vec<u8>,
-            reader: MoveReader,
-            streamed: bool,
-        }
-        impl crate::gcode::ProgramOut for Streaming {
-            fn text(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-                self.text.extend_from_slice(bytes);
-                self.reader.feed(bytes);
-                Ok(())
-            }
-            fn wants_moves(&self) -> bool {
-                true
-            }
-            fn with_sink(
-                &mut self,
-                moves: usize,
-                body: &mut dyn FnMut(&dyn crate::gcode::PieceSink) -> std::io::Result<()>,
-            ) -> Option<std::io::Result<()>> {
-                struct Sink<'s, 'r> {
-                    stream: &'s ToldStream<'r>,
-                    text: &'s std::sync::Mutex<Vec<u8>>,
-                }
-                impl crate::gcode::PieceSink for Sink<'_, '_> {
-                    fn take(&self, k: usize, piece: &ToldPiece<'_>) -> std::io::Result<()> {
-                        self.stream.take(k, piece, |at| {
-                            let mut text = self.text.lock().unwrap();
-                            let (at, end) = (at as usize, at as usize + piece.text.len());
-                            let len = text.len().max(end);
-                            text.resize(len, 0);
-                            text[at..end].copy_from_slice(piece.text);
-                        });
-                        Ok(())
-                    }
-                    fn abandon(&self) {
-                        self.stream.abandon();
-                    }
-                }
-                let at = self.text.len() as u64;
-                let text = std::sync::Mutex::new(std::mem::take(&mut self.text));
-                let mut outcome = Ok(());
-                let end = self.reader.stream_told(at, moves, |stream| {
-                    outcome = body(&Sink {
-                        stream,
-                        text: &text,
-                    });
-                });
-                self.text = text.into_inner().unwrap();
-                assert_eq!(end, Some(self.text.len() as u64));
-                self.streamed = true;
-                Some(outcome)
-            }
-        }
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        /// The program's text and its reader: the body's pieces in rounds (`told` of them with
+        /// their moves), or with `stream`, each as it is formatted through a sink.
         struct Recording {
             text: Vec<u8>,
             reader: MoveReader,
             told: usize,
+            stream: bool,
         }
         impl crate::gcode::ProgramOut for Recording {
             fn text(&mut self, bytes: &[u8]) -> std::io::Result<()> {
@@ -1113,6 +1064,52 @@ mod tests {
                 }
                 self.reader.feed_told(pieces);
                 Ok(())
+            }
+            fn with_sink(
+                &mut self,
+                moves: usize,
+                body: &mut dyn FnMut(&dyn crate::gcode::PieceSink) -> std::io::Result<()>,
+            ) -> Option<std::io::Result<()>> {
+                struct Sink<'s, 'r> {
+                    stream: &'s ToldStream<'r>,
+                    text: &'s std::sync::Mutex<Vec<u8>>,
+                    told: &'s AtomicUsize,
+                }
+                impl crate::gcode::PieceSink for Sink<'_, '_> {
+                    fn take(&self, k: usize, piece: &ToldPiece<'_>) -> std::io::Result<()> {
+                        self.told
+                            .fetch_add(usize::from(piece.moves.is_some()), Ordering::Relaxed);
+                        self.stream.take(k, piece, |at| {
+                            let mut text = self.text.lock().unwrap();
+                            let (at, end) = (at as usize, at as usize + piece.text.len());
+                            let len = text.len().max(end);
+                            text.resize(len, 0);
+                            text[at..end].copy_from_slice(piece.text);
+                        });
+                        Ok(())
+                    }
+                    fn abandon(&self) {
+                        self.stream.abandon();
+                    }
+                }
+                if !self.stream {
+                    return None;
+                }
+                let at = self.text.len() as u64;
+                let text = std::sync::Mutex::new(std::mem::take(&mut self.text));
+                let told = AtomicUsize::new(0);
+                let mut outcome = Ok(());
+                let end = self.reader.stream_told(at, moves, |stream| {
+                    outcome = body(&Sink {
+                        stream,
+                        text: &text,
+                        told: &told,
+                    });
+                });
+                self.text = text.into_inner().unwrap();
+                self.told += told.into_inner();
+                assert_eq!(end, Some(self.text.len() as u64));
+                Some(outcome)
             }
         }
         let bits = |m: &Move| (m.to.to_array().map(f64::to_bits), m.de.to_bits(), m.line);
@@ -1134,34 +1131,27 @@ mod tests {
                 job.toolpath.points.len() > 3 * 16 * 1024,
                 "several rounds of pieces"
             );
-            let mut out = Recording {
-                text: Vec::new(),
-                reader: MoveReader::with_capacity(0),
-                told: 0,
+            let write = |stream: bool| {
+                let mut out = Recording {
+                    text: Vec::new(),
+                    reader: MoveReader::with_capacity(0),
+                    told: 0,
+                    stream,
+                };
+                crate::gcode::write_program_to(&design, &job, &mut out).unwrap();
+                assert!(out.told >= 3, "{printer}: the body's pieces are told");
+                let (told, told_start) = out.reader.finish().unwrap();
+                (out.text, told, told_start)
             };
-            crate::gcode::write_program_to(&design, &job, &mut out).unwrap();
-            assert!(out.told >= 3, "{printer}: the body's pieces are told");
-            let (told, told_start) = out.reader.finish().unwrap();
-            let (read, read_start) = parse_moves(std::str::from_utf8(&out.text).unwrap()).unwrap();
-            assert_eq!(told.len(), read.len(), "{printer}");
-            assert_eq!(told_start, read_start);
-            for (t, r) in told.iter().zip(&read) {
-                assert_eq!(bits(t), bits(r), "{printer}: line {}", r.line);
-            }
-            let mut streaming = Streaming {
-                text: Vec::new(),
-                reader: MoveReader::with_capacity(0),
-                streamed: false,
-            };
-            crate::gcode::write_program_to(&design, &job, &mut streaming).unwrap();
-            assert!(
-                streaming.streamed && streaming.text == out.text,
-                "{printer}"
-            );
-            let (told, told_start) = streaming.reader.finish().unwrap();
-            assert_eq!((told.len(), told_start), (read.len(), read_start));
-            for (t, r) in told.iter().zip(&read) {
-                assert_eq!(bits(t), bits(r), "{printer}: streamed, line {}", r.line);
+            let (text, told, told_start) = write(false);
+            let (read, read_start) = parse_moves(std::str::from_utf8(&text).unwrap()).unwrap();
+            let (streamed_text, streamed, streamed_start) = write(true);
+            assert!(streamed_text == text, "{printer}: streamed, the same text");
+            for (moves, start) in [(told, told_start), (streamed, streamed_start)] {
+                assert_eq!((moves.len(), start), (read.len(), read_start), "{printer}");
+                for (t, r) in moves.iter().zip(&read) {
+                    assert_eq!(bits(t), bits(r), "{printer}: line {}", r.line);
+                }
             }
         }
     }
