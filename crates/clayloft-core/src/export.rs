@@ -310,6 +310,27 @@ mod tests {
         );
     }
 
+    /// A program the self-check cannot read (a start G-code moving past any finite number):
+    /// its body goes to the file in rounds, as the self-check takes pieces only in order after
+    /// an error, and the export fails naming the line; the old file stays, with nothing beside.
+    #[test]
+    fn a_program_the_checker_cannot_read_is_not_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("v.gcode");
+        std::fs::write(&out, "old").unwrap();
+        let (mut d, job) = vessel("");
+        d.printer.start_gcode = Some("G28\nG1 X1e999\n".into());
+        let e = write_checked_gcode(&d, &job, &out)
+            .err()
+            .expect("unreadable");
+        assert!(
+            matches!(&e, ExportError::Unreadable { error, .. } if error.message.contains("finite")),
+            "{e}"
+        );
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
     fn vessel(extra: &str) -> (Design, PrintJob) {
         let d = crate::load::parse_design(&format!(
             "version = 1\n[shape]\nheight = 20.0\nsamples = 120\nlower = {{ type = \"circle\", radius = 30.0 }}\nupper = {{ type = \"circle\", radius = 32.0 }}\n{extra}"

@@ -177,8 +177,7 @@ impl Handed {
                 .unwrap_or_else(|e| e.into_inner())
                 .take();
             // The helper is free again (for the part's own parallel work, say).
-            self.waited = true;
-            self.helper.claimed.store(false, Ordering::Release);
+            self.free_helper();
             return part
                 .filter(|_| run_here)
                 .and_then(|part| std::panic::catch_unwind(AssertUnwindSafe(part)).err());
@@ -194,15 +193,20 @@ impl Handed {
                 std::hint::spin_loop();
             }
         }
-        self.waited = true;
         let panic = self
             .helper
             .panic
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .take();
-        self.helper.claimed.store(false, Ordering::Release);
+        self.free_helper();
         panic
+    }
+
+    /// The part is done (or taken back): the helper may be claimed again.
+    fn free_helper(&mut self) {
+        self.waited = true;
+        self.helper.claimed.store(false, Ordering::Release);
     }
 
     /// Waits for the part; its panic goes on here.

@@ -78,10 +78,8 @@ impl GcodeVerifier {
         self.reader.feed_told(pieces);
     }
 
-    /// Takes pieces of the program's body as they are written, on the threads that write them
-    /// (see `ToldStream`): the first piece's text at byte `text_at` of the file, `moves` moves
-    /// in all. Gives where the last piece's text ends; none, with `run` not run, where the
-    /// pieces must come in order through [`GcodeVerifier::feed_told`].
+    /// The reader's `MoveReader::stream_told`: the body's pieces taken on the threads that
+    /// write them (none, `run` not run, where they must come through `feed_told`).
     pub(crate) fn stream_told(
         &mut self,
         text_at: u64,
@@ -122,7 +120,7 @@ fn validate(limits: &Limits) -> Result<(), GcodeError> {
 /// coordinates, always a report; with `show`, [`verify_gcode`]'s verdict: the layers first
 /// shown to hold by witnesses, and no report where they are and nothing else breaks. The moves
 /// are let go once the path is copied from them (the layer search's buffers reuse their 9 MB
-/// on the benchmark vase, whose `clayloft gcode` then fills four huge pages fewer).
+/// on the benchmark vase, whose `clayloft gcode` then fills two huge pages fewer).
 fn check_moves(
     moves: Vec<Move>,
     start: DVec3,
