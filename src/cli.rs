@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use clayloft_core::atomic::FreeingThread;
 use clayloft_core::check::{Limits, check_gcode};
 use clayloft_core::export::{ExportError, write_checked_gcode};
 use clayloft_core::gcode::{JobSummary, format_duration, summarize};
@@ -181,7 +182,12 @@ pub fn main(open: fn(Window) -> Result<ExitCode, Failure>) -> ExitCode {
             design,
             out,
             printer,
-        }) => awake(|| gcode(&design, &out, printer.as_deref())),
+        }) => {
+            // Started before the helpers (waking the second core for them), it waits for the
+            // file replaced (see `FreeingThread`).
+            let freeing = FreeingThread::start();
+            awake(|| gcode(&design, &out, printer.as_deref(), freeing))
+        }
         Some(Command::Stl {
             design,
             out,
@@ -397,7 +403,12 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
     }
 }
 
-fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
+fn gcode(
+    design: &Path,
+    out: &Path,
+    printer: Option<&str>,
+    freeing: FreeingThread<clayloft_core::atomic::Replaced>,
+) -> Result<ExitCode, Failure> {
     // The verdict on the print is left for the end (below).
     let (loaded, mut job) = job_by(clayloft_core::pipeline::run_unjudged, design, printer)?;
     // Right first time: the program is re-measured by the checker on its way to the disk, and
@@ -408,13 +419,10 @@ fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, F
     })?;
     // The system frees the file replaced on a thread of its own, mostly waiting for the disk,
     // while the cores judge the print (or here, where no thread can be started).
-    let replaced = written.replaced;
-    let freeing = std::thread::Builder::new().spawn(move || drop(replaced));
+    freeing.free(written.replaced);
     job.verdict = clayloft_core::pipeline::judge(&loaded.design, &job);
     print_summary(&loaded, &job, Some(written.summary));
-    if let Ok(freeing) = freeing {
-        let _ = freeing.join();
-    }
+    freeing.finish();
     if !written.unenforced.is_empty() {
         println!(
             "the checker finds in this G-code (constraints not enforced: written as designed):"

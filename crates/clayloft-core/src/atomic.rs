@@ -53,6 +53,60 @@ pub struct Pending {
 #[must_use = "dropped at once, the old file's data is freed here"]
 pub struct Replaced(#[allow(dead_code)] Option<std::fs::File>);
 
+/// A thread that drops what it is given ([`Replaced`] files, whose freeing waits for the disk),
+/// started ahead of the moment it is needed. A thread started at that moment waited for a core
+/// while both were busy (`clayloft gcode` judging the print): the old file's freeing began only
+/// once the judging was done, and the command ended 1.5–2 ms later than with a thread already
+/// started and waiting, which the system runs as soon as it is woken (measured on the benchmark
+/// vase). `clayloft gcode` starts it before the helpers of [`crate::parallel`]: its start wakes
+/// the idle second core (which a virtual machine halts), so that the helper started next runs
+/// at once instead of a millisecond or more later (the sections, the first stage the helper
+/// shares, 3.1 → 2.0 ms; the whole command 44.7 → 41.0 ms, medians, measured).
+pub struct FreeingThread<T: Send + 'static> {
+    to_free: Option<std::sync::mpsc::Sender<T>>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl<T: Send + 'static> FreeingThread<T> {
+    /// Starts the thread (where none can be started, [`FreeingThread::free`] drops here).
+    pub fn start() -> Self {
+        let (to_free, given) = std::sync::mpsc::channel::<T>();
+        let thread = std::thread::Builder::new()
+            .name("clayloft freeing".into())
+            .spawn(move || given.into_iter().for_each(drop))
+            .ok();
+        Self {
+            to_free: thread.is_some().then_some(to_free),
+            thread,
+        }
+    }
+
+    /// Drops `value` on the thread (here, where it could not be started).
+    pub fn free(&self, value: T) {
+        match &self.to_free {
+            Some(to_free) => {
+                if let Err(unsent) = to_free.send(value) {
+                    drop(unsent.0);
+                }
+            }
+            None => drop(value),
+        }
+    }
+
+    /// Waits until everything given is dropped (as dropping the `FreeingThread` does).
+    pub fn finish(self) {}
+}
+
+impl<T: Send + 'static> Drop for FreeingThread<T> {
+    fn drop(&mut self) {
+        // The thread ends once the channel is closed and it has dropped all it was given.
+        drop(self.to_free.take());
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
 impl Pending {
     /// Renames the temporary file over the destination, or, for a destination that is not a
     /// file, writes the data into it. Gives the file replaced, if any (see [`Replaced`]).
@@ -263,6 +317,52 @@ pub fn start_writeback(_: &std::fs::File, _: std::ops::Range<u64>) {}
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What a freeing thread is given is dropped on that thread, in order, all of it by the
+    /// time `finish` returns; a value given after the thread is gone is dropped by the caller.
+    #[test]
+    fn a_freeing_thread_drops_what_it_is_given_before_finish_returns() {
+        use std::sync::{Arc, Mutex};
+        struct Noted(usize, Arc<Mutex<Vec<(usize, std::thread::ThreadId)>>>);
+        impl Drop for Noted {
+            fn drop(&mut self) {
+                self.1
+                    .lock()
+                    .unwrap()
+                    .push((self.0, std::thread::current().id()));
+            }
+        }
+        let dropped = Arc::new(Mutex::new(Vec::new()));
+        let freeing = FreeingThread::start();
+        for k in 0..3 {
+            freeing.free(Noted(k, Arc::clone(&dropped)));
+        }
+        freeing.finish();
+        let dropped = std::mem::take(&mut *dropped.lock().unwrap());
+        assert_eq!(dropped.iter().map(|d| d.0).collect::<Vec<_>>(), [0, 1, 2]);
+        let here = std::thread::current().id();
+        assert!(dropped.iter().all(|d| d.1 == dropped[0].1 && d.1 != here));
+    }
+
+    /// A file replaced and given to a freeing thread is closed by the time `finish` returns.
+    #[cfg(unix)]
+    #[test]
+    fn a_replaced_file_given_to_a_freeing_thread_is_closed_when_it_finishes() {
+        use std::os::fd::AsRawFd;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("old.gcode");
+        std::fs::write(&path, "G1 X1\n").unwrap();
+        let old = std::fs::File::open(&path).unwrap();
+        let fd = old.as_raw_fd();
+        std::fs::remove_file(&path).unwrap();
+        let freeing = FreeingThread::start();
+        freeing.free(Replaced(Some(old)));
+        freeing.finish();
+        // The descriptor is no longer this file's: closed (or, if another test's file took the
+        // number meanwhile, another file).
+        let link = std::fs::read_link(format!("/proc/self/fd/{fd}"));
+        assert!(link.is_err() || !link.unwrap().to_string_lossy().contains("old.gcode"));
+    }
 
     /// Starting a file's data for the disk, whatever the range (empty, reversed, past the end,
     /// to the end), leaves the data as written.
