@@ -80,10 +80,13 @@ pub fn tune_for_batch_command() -> Option<std::ops::Range<usize>> {
 static ROOM: std::sync::OnceLock<std::ops::Range<usize>> = std::sync::OnceLock::new();
 
 /// Heap a batch command fills per path point, bytes: the benchmark vase's `clayloft gcode`
-/// fills 40 MB of the room for its 216 000 points (its resident size stays 75 MB when that much
-/// is faulted in ahead, and grows past it with more).
+/// fills 36.9 MB of the room for its 216 000 points (the heap's resident size with nothing
+/// faulted in ahead, since the self-check lets the moves go), 172 bytes a point, rounded up
+/// to whole huge pages. Faulting in 190 a point (as before) zeroed two huge pages no stage
+/// used: 40.5 → 40.1 ms median with 172; with 150 the rest faulted on the stage's own thread,
+/// 40.5 ms again (alternating, 600 rounds, 2026-12-07).
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
-const BYTES_PER_POINT: usize = 190;
+const BYTES_PER_POINT: usize = 172;
 
 /// Has the idle helper fault in, ahead of use, the part of the heap's room that a job of
 /// `design` fills ([`crate::parallel::fault_in_while_idle`]): the kernel's zeroing of those
