@@ -318,8 +318,8 @@ pub fn start_writeback(_: &std::fs::File, _: std::ops::Range<u64>) {}
 mod tests {
     use super::*;
 
-    /// What a freeing thread is given is dropped on that thread, in order, all of it by the
-    /// time `finish` returns; a value given after the thread is gone is dropped by the caller.
+    /// What a freeing thread is given is dropped on that thread (not the caller's), in order,
+    /// all of it by the time `finish` returns.
     #[test]
     fn a_freeing_thread_drops_what_it_is_given_before_finish_returns() {
         use std::sync::{Arc, Mutex};
