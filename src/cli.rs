@@ -182,12 +182,7 @@ pub fn main(open: fn(Window) -> Result<ExitCode, Failure>) -> ExitCode {
             design,
             out,
             printer,
-        }) => {
-            // Started before the helpers (waking the second core for them), it waits for the
-            // file replaced (see `FreeingThread`).
-            let freeing = FreeingThread::start();
-            awake(|| gcode(&design, &out, printer.as_deref(), freeing))
-        }
+        }) => awake(|| gcode(&design, &out, printer.as_deref())),
         Some(Command::Stl {
             design,
             out,
@@ -403,12 +398,9 @@ fn print_summary(loaded: &LoadedDesign, job: &PrintJob, summary: Option<JobSumma
     }
 }
 
-fn gcode(
-    design: &Path,
-    out: &Path,
-    printer: Option<&str>,
-    freeing: FreeingThread<clayloft_core::atomic::Replaced>,
-) -> Result<ExitCode, Failure> {
+fn gcode(design: &Path, out: &Path, printer: Option<&str>) -> Result<ExitCode, Failure> {
+    // Started now, it waits for the file replaced (see `FreeingThread`).
+    let freeing = FreeingThread::start();
     // The verdict on the print is left for the end (below).
     let (loaded, mut job) = job_by(clayloft_core::pipeline::run_unjudged, design, printer)?;
     // Right first time: the program is re-measured by the checker on its way to the disk, and

@@ -58,10 +58,7 @@ pub struct Replaced(#[allow(dead_code)] Option<std::fs::File>);
 /// while both were busy (`clayloft gcode` judging the print): the old file's freeing began only
 /// once the judging was done, and the command ended 1.5–2 ms later than with a thread already
 /// started and waiting, which the system runs as soon as it is woken (measured on the benchmark
-/// vase). `clayloft gcode` starts it before the helpers of [`crate::parallel`]: its start wakes
-/// the idle second core (which a virtual machine halts), so that the helper started next runs
-/// at once instead of a millisecond or more later (the sections, the first stage the helper
-/// shares, 3.1 → 2.0 ms; the whole command 44.7 → 41.0 ms, medians, measured).
+/// vase).
 pub struct FreeingThread<T: Send + 'static> {
     to_free: Option<std::sync::mpsc::Sender<T>>,
     thread: Option<std::thread::JoinHandle<()>>,

