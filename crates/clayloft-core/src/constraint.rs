@@ -22,6 +22,21 @@ pub struct SurfaceMetrics {
     /// Smallest and largest local layer height, mm.
     pub min_layer_height: f64,
     pub max_layer_height: f64,
+    /// The box (min, max) in XY of every point of the sections, and the highest point's z,
+    /// mm: whether the wall fits the machine (measured here, in the same pass).
+    pub xy_box: (DVec2, DVec2),
+    pub top: f64,
+}
+
+impl SurfaceMetrics {
+    /// Nothing measured yet: extremes that any measurement replaces.
+    fn unmeasured() -> SurfaceMetrics {
+        SurfaceMetrics {
+            min_layer_height: f64::INFINITY,
+            xy_box: (DVec2::INFINITY, DVec2::NEG_INFINITY),
+            ..Default::default()
+        }
+    }
 }
 
 /// Clamps the normal offset of every point of sections `from ..` against the section below, and
@@ -391,10 +406,7 @@ fn measure_in_parts(sections: &[Section], keep_leans: bool) -> (SurfaceMetrics, 
     let parts = crate::parallel::map_runs(sections.len(), 64, MEASURE_RUN, |r| {
         vec![measure_part(sections, r, keep_leans)]
     });
-    let mut m = SurfaceMetrics {
-        min_layer_height: f64::INFINITY,
-        ..Default::default()
-    };
+    let mut m = SurfaceMetrics::unmeasured();
     let mut leans = Vec::with_capacity(if keep_leans {
         sections.iter().map(|s| s.points.len()).sum()
     } else {
@@ -405,6 +417,8 @@ fn measure_in_parts(sections: &[Section], keep_leans: bool) -> (SurfaceMetrics, 
         m.max_layer_z_range = m.max_layer_z_range.max(part.max_layer_z_range);
         m.min_layer_height = m.min_layer_height.min(part.min_layer_height);
         m.max_layer_height = m.max_layer_height.max(part.max_layer_height);
+        m.xy_box = (m.xy_box.0.min(part.xy_box.0), m.xy_box.1.max(part.xy_box.1));
+        m.top = m.top.max(part.top);
         leans.extend_from_slice(&part_leans);
     }
     if !m.min_layer_height.is_finite() {
@@ -463,10 +477,7 @@ fn measure_part(
     range: std::ops::Range<usize>,
     keep_leans: bool,
 ) -> (SurfaceMetrics, Vec<f32>) {
-    let mut m = SurfaceMetrics {
-        min_layer_height: f64::INFINITY,
-        ..Default::default()
-    };
+    let mut m = SurfaceMetrics::unmeasured();
     let mut leans = Vec::with_capacity(if keep_leans {
         sections[range.clone()].iter().map(|s| s.points.len()).sum()
     } else {
@@ -477,6 +488,10 @@ fn measure_part(
     for k in range {
         let s = &sections[k];
         if k == 0 {
+            for p in &s.points {
+                m.xy_box = (m.xy_box.0.min(p.truncate()), m.xy_box.1.max(p.truncate()));
+                m.top = m.top.max(p.z);
+            }
             if keep_leans {
                 leans.resize(s.points.len(), 0.0);
             }
@@ -488,6 +503,8 @@ fn measure_part(
         let normals = prev.normals();
         for (i, p) in s.points.iter().enumerate() {
             let q = prev.points[i];
+            m.xy_box = (m.xy_box.0.min(p.truncate()), m.xy_box.1.max(p.truncate()));
+            m.top = m.top.max(p.z);
             let dz = p.z - q.z;
             m.min_layer_height = m.min_layer_height.min(dz);
             m.max_layer_height = m.max_layer_height.max(dz);
@@ -726,6 +743,12 @@ mod tests {
             proptest::prop_assert_eq!(m.max_overhang_deg.to_bits(), exact.to_bits());
             // Without the leans kept (the command line's surface), the same metrics.
             proptest::prop_assert_eq!(measure(&sections), m);
+            // The box and top of every point, the first section's included.
+            let all = sections.iter().flat_map(|s| &s.points);
+            let lo = all.clone().fold(DVec2::INFINITY, |b, p| b.min(p.truncate()));
+            let hi = all.clone().fold(DVec2::NEG_INFINITY, |b, p| b.max(p.truncate()));
+            let top = all.map(|p| p.z).fold(0.0, f64::max);
+            proptest::prop_assert_eq!((m.xy_box, m.top), ((lo, hi), top));
         }
     }
 

@@ -214,23 +214,8 @@ pub fn finish_sections(
 fn check_fits_machine(design: &Design, surface: &Surface) -> Result<(), FieldError> {
     let p = &design.printer;
     let half = p.line_width / 2.0;
-    // The wall's box and top, the sections in parts on the machine's cores (extremes merge
-    // exactly in any order).
-    let none = (
-        DVec2::splat(f64::INFINITY),
-        DVec2::splat(f64::NEG_INFINITY),
-        0.0_f64,
-    );
-    let parts = crate::parallel::map_ranges(surface.sections.len(), 64, |r| {
-        let mut b = none;
-        for q in surface.sections[r].iter().flat_map(|s| &s.points) {
-            b = (b.0.min(q.truncate()), b.1.max(q.truncate()), b.2.max(q.z));
-        }
-        vec![b]
-    });
-    let (lo, hi, top) = parts
-        .into_iter()
-        .fold(none, |a, b| (a.0.min(b.0), a.1.max(b.1), a.2.max(b.2)));
+    // The wall's box and top, measured with the rest of its metrics.
+    let ((lo, hi), top) = (surface.metrics.xy_box, surface.metrics.top);
     let (lo, hi) = (lo - half, hi + half);
     let field = if design.shape.center.is_some() {
         "shape.center"
