@@ -362,13 +362,14 @@ fn without_spikes(mut pts: Vec<DVec2>) -> Vec<DVec2> {
 /// offset of an arc is an arc: nothing is lost from level to level), and the offset by w/2
 /// where that middle ring is not covered by a deeper one.
 ///
-/// `meanwhile` runs on this core once the rings are made, while a second may still be making
-/// the middle rings (not at all when the foot is too deep); `rings_made` once both are done.
+/// `beside` runs on the second core before it makes the middle rings, while this one makes the
+/// rings (here after them, with no second core; not at all when the foot is too deep);
+/// `rings_made` once both are done.
 fn ring_tree(
     foot: &[DVec2],
     w: f64,
     rings_made: impl FnOnce(),
-    meanwhile: impl FnOnce(),
+    beside: impl FnOnce() + Send,
 ) -> Result<Node, FillError> {
     let max_levels = ring_levels(foot, w);
     if max_levels > MAX_RING_LEVELS {
@@ -379,7 +380,7 @@ fn ring_tree(
         step: 0.0,
         children: Vec::new(),
     };
-    grow(&mut root, &polyline(foot), w, max_levels, meanwhile)?;
+    grow(&mut root, &polyline(foot), w, max_levels, beside)?;
     rings_made();
     orient(&mut root, true, w);
     prune_spurs(&mut root);
@@ -398,31 +399,26 @@ fn grow(
     exact: &Polyline<f64>,
     w: f64,
     levels: usize,
-    meanwhile: impl FnOnce(),
+    beside: impl FnOnce() + Send,
 ) -> Result<(), FillError> {
-    grow_on(
-        root,
-        exact,
-        w,
-        levels,
-        crate::parallel::cores() > 1,
-        meanwhile,
-    )
+    grow_on(root, exact, w, levels, crate::parallel::cores() > 1, beside)
 }
 
-/// [`grow`], with the middle rings on a second thread or not.
+/// [`grow`], with `beside` and the middle rings on a second thread or not.
 fn grow_on(
     root: &mut Node,
     exact: &Polyline<f64>,
     w: f64,
     levels: usize,
     two_threads: bool,
-    meanwhile: impl FnOnce(),
+    beside: impl FnOnce() + Send,
 ) -> Result<(), FillError> {
     let (send, receive) = std::sync::mpsc::channel::<Polyline<f64>>();
     // On a helper this waits for each ring by spinning (a ring takes tens of microseconds, a
-    // sleeping thread as long to wake); run after the rings, it finds them all sent.
+    // sleeping thread as long to wake); run after the rings, it finds them all sent. `beside`
+    // first: the rings it finds waiting then are offset one after another.
     let offset_all = move || -> Vec<_> {
+        beside();
         let (mut out, mut spins) = (Vec::new(), 0u32);
         loop {
             match receive.try_recv() {
@@ -443,7 +439,6 @@ fn grow_on(
     let (middles, grown) = crate::parallel::both(two_threads && levels > 1, offset_all, || {
         let grown = grow_rings(root, exact, w, levels, &send);
         drop(send);
-        meanwhile();
         grown
     });
     grown?;
@@ -1029,8 +1024,8 @@ pub fn fill_feet_then(
     if feet.iter().any(|f| f.len() < 3) || w.is_nan() || w <= 0.0 {
         return Err(FillError::NarrowerThanABead);
     }
-    // Where the foot is narrower than a bead: measured on this core once the rings are made,
-    // while the second finishes the middle rings (its error comes first, as if run first).
+    // Where the foot is narrower than a bead: measured on the second core while this one makes
+    // the rings (its error comes first, as if run first).
     let narrowness = || -> Result<Option<NarrowSpot>, FillError> {
         let eroded = offset(&polyline(first), 0.5 * w)?;
         if eroded.is_empty() {
