@@ -6,7 +6,9 @@ use std::sync::Arc;
 
 use glam::DVec2;
 
-use crate::constraint::{SurfaceMetrics, clamp_overhang, measure, measure_with_leans};
+use crate::constraint::{
+    SurfaceMetrics, clamp_overhang, clamp_overhang_measured, measure, measure_with_leans,
+};
 use crate::design::Design;
 use crate::loft::LoftInput;
 use crate::report::{Finding, FindingKind, group_events};
@@ -127,6 +129,8 @@ pub fn finish_sections(
 ) -> Result<Surface, FieldError> {
     let center = grid.center;
     findings.extend(correct_shape(design, &mut sections, 1));
+    // The metrics, where taken as the texture's last correction is made.
+    let mut measured = None;
     if let Some(tex) = &design.texture {
         let enforce = design.constraints.enforce;
         // The overhang limit, and never a bead wholly beside the one below it (half a bead out
@@ -167,13 +171,17 @@ pub fn finish_sections(
             });
             findings.append(&mut f);
         }
-        // Safety net: whatever the column scaling missed (normals turn with the texture).
-        let residual = clamp_overhang(
-            &mut sections,
-            1,
-            overhang_tan_limit(design) / LIMIT_MARGIN,
-            enforce,
-        );
+        // Safety net: whatever the column scaling missed (normals turn with the texture). The
+        // wall is measured as it is clamped, where nothing moves it after (a seam of several
+        // beads does) and no point's lean is kept.
+        let tan = overhang_tan_limit(design) / LIMIT_MARGIN;
+        let residual = if design.shape.walls > 1 || keep_leans {
+            clamp_overhang(&mut sections, 1, tan, enforce)
+        } else {
+            let (events, metrics) = clamp_overhang_measured(&mut sections, tan, enforce);
+            measured = Some(metrics);
+            events
+        };
         findings.extend(group_events(
             &residual,
             FindingKind::Texture,
@@ -192,10 +200,10 @@ pub fn finish_sections(
         );
         crate::seam::start_at(&mut sections, seam);
     }
-    let (metrics, point_leans_deg) = if keep_leans {
-        measure_with_leans(&sections)
-    } else {
-        (measure(&sections), Vec::new())
+    let (metrics, point_leans_deg) = match measured {
+        Some(metrics) => (metrics, Vec::new()),
+        None if keep_leans => measure_with_leans(&sections),
+        None => (measure(&sections), Vec::new()),
     };
     let surface = Surface {
         sections,
