@@ -1538,6 +1538,16 @@ mod properties {
     use super::*;
     use proptest::prelude::*;
 
+    /// A foot with radius `radii[i]` at the i-th of as many equal angles.
+    fn jagged(radii: &[f64]) -> Vec<DVec2> {
+        let n = radii.len();
+        radii
+            .iter()
+            .enumerate()
+            .map(|(i, r)| DVec2::from_angle(std::f64::consts::TAU * i as f64 / n as f64) * *r)
+            .collect()
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(40))]
 
@@ -1587,12 +1597,7 @@ mod properties {
             radii in proptest::collection::vec(1.0..40.0f64, 12..400),
             w in 0.8..6.0f64,
         ) {
-            let n = radii.len();
-            let foot: Vec<DVec2> = radii
-                .iter()
-                .enumerate()
-                .map(|(i, r)| DVec2::from_angle(std::f64::consts::TAU * i as f64 / n as f64) * *r)
-                .collect();
+            let foot = jagged(&radii);
             let Ok(eroded) = offset(&polyline(&foot), 0.5 * w) else {
                 return Ok(());
             };
@@ -1623,12 +1628,7 @@ mod properties {
             radii in proptest::collection::vec(5.0..50.0f64, 12..240),
             w in 0.8..5.0f64,
         ) {
-            let n = radii.len();
-            let foot: Vec<DVec2> = radii
-                .iter()
-                .enumerate()
-                .map(|(i, r)| DVec2::from_angle(std::f64::consts::TAU * i as f64 / n as f64) * *r)
-                .collect();
+            let foot = jagged(&radii);
             if let Ok(fill) = fill_foot(&foot, w) {
                 let p = &fill.path;
                 prop_assert!(p[0].distance(foot[0]) < 1e-9);
