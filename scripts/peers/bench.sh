@@ -5,6 +5,10 @@
 # write are timed). Not part of CI: it installs PrusaSlicer (Debian) and FullControl (PyPI).
 #   scripts/peers/bench.sh                 # five rounds: ratios of medians and of minimums
 #   scripts/peers/bench.sh --rounds 10     # (options of scripts/peers/ratios.py)
+#   scripts/peers/bench.sh --placement "$CARGO_TARGET_DIR/release/examples/core_round_trip"
+#                                          # also Clayloft's runs by where the cores sit (build
+#                                          # the probe: cargo build --release -p clayloft-core
+#                                          # --example core_round_trip)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 target="${CARGO_TARGET_DIR:-$HOME/.cache/clayloft-target}"

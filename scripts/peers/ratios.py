@@ -5,12 +5,21 @@ times, then PrusaSlicer's spiral vase once, then FullControl's transform once, s
 machine's drifting speed falls on all three alike. Called by `bench.sh`, which installs the peers.
 
     ratios.py CLAYLOFT PRUSA_SLICER FC_PYTHON WORK_DIR [--rounds 5] [--clayloft-runs 10]
+              [--placement PROBE]
 
 Prints each round's times, then the medians and minimums of each tool (ms) and the ratios of
 median to median and of minimum to minimum. Clayloft is timed as a whole process (start to exit,
 `os.wait4`); PrusaSlicer as a whole process too; FullControl only for its own work (steps to
 G-code text to file, timed inside Python by `fullcontrol_spiral.py`, which reads the points
 from Clayloft's G-code first).
+
+With `--placement PROBE` (the core-to-core round trip in ns: `cargo build --release -p
+clayloft-core --example core_round_trip`), the probe runs before and after each Clayloft run,
+and the Clayloft runs whose two cores shared a cache both times (under 200 ns) and those whose
+cores the host placed apart (over 200 ns both times) are also given apart, with their ratios to
+the peers' medians. On the development machine, a virtual machine, the host moves the two
+virtual cores between sharing a cache and not every few seconds to minutes, which moves
+`clayloft gcode` by a fifth (a potter's own machine has its cores on one chip).
 """
 import argparse
 import os
@@ -30,6 +39,8 @@ parser.add_argument("fc_python")
 parser.add_argument("work")
 parser.add_argument("--rounds", type=int, default=5)
 parser.add_argument("--clayloft-runs", type=int, default=10)
+parser.add_argument("--placement", metavar="PROBE",
+                    help="core_round_trip example: Clayloft's runs also given by placement")
 args = parser.parse_args()
 if args.rounds < 1 or args.clayloft_runs < 1:
     parser.error("--rounds and --clayloft-runs must be at least 1")
@@ -57,10 +68,29 @@ prusa = [args.prusa_slicer, "--export-gcode", "--spiral-vase",
 fullcontrol = [args.fc_python, str(ROOT / "scripts/peers/fullcontrol_spiral.py"),
                str(clayloft_gcode), str(work / "fc.gcode")]
 
+# A round trip above this, ns, means the two cores share no cache (see --placement).
+APART_NS = 200
+
+
+def placement():
+    """Where the cores sit now: "together" or "apart" (by the probe's round trip)."""
+    said = subprocess.run([args.placement], capture_output=True, text=True, check=True).stdout
+    return "apart" if int(said.split()[0]) > APART_NS else "together"
+
+
+def clayloft_run(placed):
+    """One `clayloft gcode` run, its wall time; with a probe, filed by placement in `placed`."""
+    before = placement() if args.placement else None
+    ms = wall_ms([args.clayloft, "gcode", str(DESIGN), "-o", str(clayloft_gcode)])
+    if args.placement and placement() == before:
+        placed[before].append(ms)
+    return ms
+
+
 times = {"clayloft": [], "prusaslicer": [], "fullcontrol": []}
+placed = {"together": [], "apart": []}
 for r in range(args.rounds):
-    ours = [wall_ms([args.clayloft, "gcode", str(DESIGN), "-o", str(clayloft_gcode)])
-            for _ in range(args.clayloft_runs)]
+    ours = [clayloft_run(placed) for _ in range(args.clayloft_runs)]
     times["clayloft"] += ours
     times["prusaslicer"].append(wall_ms(prusa))
     said = subprocess.run(fullcontrol, capture_output=True, text=True, check=True).stdout
@@ -79,3 +109,9 @@ for k in times:
 for peer, goal in (("prusaslicer", 100), ("fullcontrol", 50)):
     print(f"clayloft vs {peer}: {median[peer] / median['clayloft']:.0f}x median to median, "
           f"{least[peer] / least['clayloft']:.0f}x minimum to minimum (goal {goal}x)")
+for where, runs in placed.items():
+    if runs:
+        m = statistics.median(runs)
+        print(f"clayloft, cores {where}: median {m:.1f} ms ({len(runs)} runs): "
+              f"{median['prusaslicer'] / m:.0f}x prusaslicer, "
+              f"{median['fullcontrol'] / m:.0f}x fullcontrol (the peers' medians)")
