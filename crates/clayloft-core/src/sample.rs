@@ -62,7 +62,7 @@ fn twist_within(a: &[DVec2], b: &[DVec2], o: usize, bound: f64) -> Option<f64> {
     {
         sum += p.distance_squared(*q);
         // Tested every few terms: a comparison a term costs more than it saves.
-        if k % TWIST_TEST_EVERY == 0 && sum > bound {
+        if k.is_multiple_of(TWIST_TEST_EVERY) && sum > bound {
             return None;
         }
     }
@@ -112,7 +112,7 @@ fn twist_min(lower: &[DVec2], upper: &[DVec2], range: std::ops::Range<usize>) ->
     let first = range.clone().step_by(TWIST_COARSE);
     let rest = range
         .clone()
-        .filter(|o| (o - range.start) % TWIST_COARSE != 0);
+        .filter(|o| !(o - range.start).is_multiple_of(TWIST_COARSE));
     for o in first.chain(rest) {
         if let Some(t) = twist_within(lower, upper, o, best.0) {
             let candidate = (t, o);
