@@ -392,8 +392,9 @@ fn ring_tree(
 ///
 /// The middle rings (offsets by w/2) do not depend on the rings inside them, so a second core
 /// offsets them while this one goes down the rings: [`grow_rings`] hands each ring's exact
-/// outline over as it is made, [`add_middles`] puts their offsets in afterwards, in the same
-/// order. The tree is the one made on one core.
+/// outline over as it is made, this core takes those still waiting once the rings are made,
+/// and [`add_middles`] puts their offsets in afterwards, in the order they were handed over.
+/// The tree is the one made on one core.
 fn grow(
     root: &mut Node,
     exact: &Polyline<f64>,
@@ -413,36 +414,101 @@ fn grow_on(
     two_threads: bool,
     beside: impl FnOnce() + Send,
 ) -> Result<(), FillError> {
-    let (send, receive) = std::sync::mpsc::channel::<Polyline<f64>>();
+    let middles = Middles::default();
     // On a helper this waits for each ring by spinning (a ring takes tens of microseconds, a
-    // sleeping thread as long to wake); run after the rings, it finds them all sent. `beside`
+    // sleeping thread as long to wake); run after the rings, it finds them all made. `beside`
     // first: the rings it finds waiting then are offset one after another.
-    let offset_all = move || -> Vec<_> {
+    let offset_all = || {
         beside();
-        let (mut out, mut spins) = (Vec::new(), 0u32);
+        let mut spins = 0u32;
         loop {
-            match receive.try_recv() {
-                Ok(pl) => out.push(offset(&pl, 0.5 * w)),
-                Err(std::sync::mpsc::TryRecvError::Empty) => {
+            match middles.offset_next(w) {
+                Next::Made => {}
+                Next::Waiting => {
                     // Let the ring maker have the core should it have lost its own.
                     spins = spins.wrapping_add(1);
-                    if spins % 65_536 == 0 {
+                    if spins.is_multiple_of(65_536) {
                         std::thread::yield_now();
                     } else {
                         std::hint::spin_loop();
                     }
                 }
-                Err(std::sync::mpsc::TryRecvError::Disconnected) => return out,
+                Next::AllMade => return,
             }
         }
     };
-    let (middles, grown) = crate::parallel::both(two_threads && levels > 1, offset_all, || {
-        let grown = grow_rings(root, exact, w, levels, &send);
-        drop(send);
+    let ((), grown) = crate::parallel::both(two_threads && levels > 1, offset_all, || {
+        let grown = grow_rings(root, exact, w, levels, &middles);
+        middles.all_rings_made();
+        // The middle rings still waiting, shared with the second core (which measured the
+        // foot's narrow spot first).
+        while let Next::Made = middles.offset_next(w) {}
         grown
     });
     grown?;
-    add_middles(root, &mut middles.into_iter(), w, levels)
+    add_middles(root, &mut middles.in_order().into_iter(), w, levels)
+}
+
+/// The middle rings of [`grow_on`]: the exact outlines of the rings made so far that wait for
+/// their offset by half a bead, numbered in the order they were made, and the offsets made by
+/// whichever core took them.
+#[derive(Default)]
+struct Middles {
+    /// Waiting outlines, how many were given, and whether every ring is made.
+    waiting: std::sync::Mutex<(
+        std::collections::VecDeque<(usize, Polyline<f64>)>,
+        usize,
+        bool,
+    )>,
+    made: std::sync::Mutex<Vec<(usize, Result<Vec<Vec<DVec2>>, FillError>)>>,
+}
+
+/// What [`Middles::offset_next`] did.
+enum Next {
+    /// Offset a waiting outline.
+    Made,
+    /// Found none waiting: more rings are being made.
+    Waiting,
+    /// Found none waiting, and every ring is made.
+    AllMade,
+}
+
+impl Middles {
+    /// A ring's exact outline, to wait for its middle ring.
+    fn give(&self, outline: Polyline<f64>) {
+        let mut waiting = self.waiting.lock().unwrap_or_else(|e| e.into_inner());
+        let k = waiting.1;
+        waiting.0.push_back((k, outline));
+        waiting.1 += 1;
+    }
+
+    /// Every ring is made: no outline comes after those given.
+    fn all_rings_made(&self) {
+        self.waiting.lock().unwrap_or_else(|e| e.into_inner()).2 = true;
+    }
+
+    /// Offsets the first waiting outline by half of `w` (outside the lock).
+    fn offset_next(&self, w: f64) -> Next {
+        let next = {
+            let mut waiting = self.waiting.lock().unwrap_or_else(|e| e.into_inner());
+            match waiting.0.pop_front() {
+                Some(next) => next,
+                None if waiting.2 => return Next::AllMade,
+                None => return Next::Waiting,
+            }
+        };
+        let middle = offset(&next.1, 0.5 * w);
+        let mut made = self.made.lock().unwrap_or_else(|e| e.into_inner());
+        made.push((next.0, middle));
+        Next::Made
+    }
+
+    /// The middle rings in the order their outlines were given.
+    fn in_order(self) -> Vec<Result<Vec<Vec<DVec2>>, FillError>> {
+        let mut made = self.made.into_inner().unwrap_or_else(|e| e.into_inner());
+        made.sort_unstable_by_key(|m| m.0);
+        made.into_iter().map(|m| m.1).collect()
+    }
 }
 
 /// The rings one level inside `node` (exactly `exact`), and theirs, `levels` deep; the exact
@@ -453,14 +519,13 @@ fn grow_rings(
     exact: &Polyline<f64>,
     w: f64,
     levels: usize,
-    middles: &std::sync::mpsc::Sender<Polyline<f64>>,
+    middles: &Middles,
 ) -> Result<(), FillError> {
     if levels == 0 {
         return Ok(());
     }
     if node.step > 0.0 {
-        // The receiver only goes away once every ring is made.
-        let _ = middles.send(exact.clone());
+        middles.give(exact.clone());
     }
     for (inner, ring) in offset_exact(exact, w)? {
         let mut child = Node {
@@ -1338,16 +1403,27 @@ mod tests {
         );
         for foot in [rose, waist] {
             let levels = ring_levels(&foot, 3.0);
-            let grown = |two| {
+            // `beside` held for a while, the middle rings are mostly taken by this core, once
+            // its rings are made: in between, by both.
+            let grown = |two, hold_us: u64| {
                 let mut root = Node {
                     ring: Ring::new(foot.clone()),
                     step: 0.0,
                     children: Vec::new(),
                 };
-                grow_on(&mut root, &polyline(&foot), 3.0, levels, two, || ()).unwrap();
+                let hold = || {
+                    let start = std::time::Instant::now();
+                    while start.elapsed() < std::time::Duration::from_micros(hold_us) {
+                        std::hint::spin_loop();
+                    }
+                };
+                grow_on(&mut root, &polyline(&foot), 3.0, levels, two, hold).unwrap();
                 format!("{root:?}")
             };
-            assert_eq!(grown(true), grown(false));
+            let one = grown(false, 0);
+            for hold_us in [0, 200, 2_000, 20_000] {
+                assert_eq!(grown(true, hold_us), one, "{hold_us} µs");
+            }
         }
     }
 
