@@ -454,13 +454,17 @@ fn grow_on(
 /// whichever core took them.
 #[derive(Default)]
 struct Middles {
-    /// Waiting outlines, how many were given, and whether every ring is made.
-    waiting: std::sync::Mutex<(
-        std::collections::VecDeque<(usize, Polyline<f64>)>,
-        usize,
-        bool,
-    )>,
+    waiting: std::sync::Mutex<Waiting>,
     made: std::sync::Mutex<Vec<(usize, Result<Vec<Vec<DVec2>>, FillError>)>>,
+}
+
+/// The outlines waiting in [`Middles`], numbered; how many were given; whether every ring is
+/// made.
+#[derive(Default)]
+struct Waiting {
+    outlines: std::collections::VecDeque<(usize, Polyline<f64>)>,
+    given: usize,
+    all_made: bool,
 }
 
 /// What [`Middles::offset_next`] did.
@@ -477,23 +481,26 @@ impl Middles {
     /// A ring's exact outline, to wait for its middle ring.
     fn give(&self, outline: Polyline<f64>) {
         let mut waiting = self.waiting.lock().unwrap_or_else(|e| e.into_inner());
-        let k = waiting.1;
-        waiting.0.push_back((k, outline));
-        waiting.1 += 1;
+        let k = waiting.given;
+        waiting.outlines.push_back((k, outline));
+        waiting.given += 1;
     }
 
     /// Every ring is made: no outline comes after those given.
     fn all_rings_made(&self) {
-        self.waiting.lock().unwrap_or_else(|e| e.into_inner()).2 = true;
+        self.waiting
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .all_made = true;
     }
 
     /// Offsets the first waiting outline by half of `w` (outside the lock).
     fn offset_next(&self, w: f64) -> Next {
         let next = {
             let mut waiting = self.waiting.lock().unwrap_or_else(|e| e.into_inner());
-            match waiting.0.pop_front() {
+            match waiting.outlines.pop_front() {
                 Some(next) => next,
-                None if waiting.2 => return Next::AllMade,
+                None if waiting.all_made => return Next::AllMade,
                 None => return Next::Waiting,
             }
         };
