@@ -455,8 +455,12 @@ fn grow_on(
 #[derive(Default)]
 struct Middles {
     waiting: std::sync::Mutex<Waiting>,
-    made: std::sync::Mutex<Vec<(usize, Result<Vec<Vec<DVec2>>, FillError>)>>,
+    /// The middle rings made, each with its outline's number.
+    made: std::sync::Mutex<Vec<(usize, MiddleRing)>>,
 }
+
+/// A ring's offset by half a bead (one ring or several, where it splits).
+type MiddleRing = Result<Vec<Vec<DVec2>>, FillError>;
 
 /// The outlines waiting in [`Middles`], numbered; how many were given; whether every ring is
 /// made.
@@ -511,7 +515,7 @@ impl Middles {
     }
 
     /// The middle rings in the order their outlines were given.
-    fn in_order(self) -> Vec<Result<Vec<Vec<DVec2>>, FillError>> {
+    fn in_order(self) -> Vec<MiddleRing> {
         let mut made = self.made.into_inner().unwrap_or_else(|e| e.into_inner());
         made.sort_unstable_by_key(|m| m.0);
         made.into_iter().map(|m| m.1).collect()
