@@ -438,8 +438,12 @@ fn grow_on(
         }
     };
     let ((), grown) = crate::parallel::both(two_threads && levels > 1, offset_all, || {
-        let grown = grow_rings(root, exact, w, levels, &middles);
-        middles.all_rings_made();
+        let grown = {
+            // Every ring is made once this is dropped, on unwinding too: the second core, waiting
+            // for more, never waits for rings that will not come.
+            let _made = RingsMade(&middles);
+            grow_rings(root, exact, w, levels, &middles)
+        };
         // The middle rings still waiting, shared with the second core (which measured the
         // foot's narrow spot first).
         while let Next::Made = middles.offset_next(w) {}
@@ -469,6 +473,15 @@ struct Waiting {
     outlines: std::collections::VecDeque<(usize, Polyline<f64>)>,
     given: usize,
     all_made: bool,
+}
+
+/// Says every ring is made ([`Middles::all_rings_made`]) when dropped.
+struct RingsMade<'a>(&'a Middles);
+
+impl Drop for RingsMade<'_> {
+    fn drop(&mut self) {
+        self.0.all_rings_made();
+    }
 }
 
 /// What [`Middles::offset_next`] did.

@@ -129,8 +129,10 @@ pub fn finish_sections(
 ) -> Result<Surface, FieldError> {
     let center = grid.center;
     findings.extend(correct_shape(design, &mut sections, 1));
-    // The metrics, where taken as the texture's last correction is made.
+    // The metrics, where taken as the texture's last correction is made; a wall of several
+    // beads is turned to its seam after it (below), and measured then.
     let mut measured = None;
+    let seam_after = design.shape.walls > 1;
     if let Some(tex) = &design.texture {
         let enforce = design.constraints.enforce;
         // The overhang limit, and never a bead wholly beside the one below it (half a bead out
@@ -172,10 +174,10 @@ pub fn finish_sections(
             findings.append(&mut f);
         }
         // Safety net: whatever the column scaling missed (normals turn with the texture). The
-        // wall is measured as it is clamped, where nothing moves it after (a seam of several
-        // beads does) and no point's lean is kept.
+        // wall is measured as it is clamped where nothing moves it after and no point's lean
+        // is kept.
         let tan = overhang_tan_limit(design) / LIMIT_MARGIN;
-        let residual = if design.shape.walls > 1 || keep_leans {
+        let residual = if seam_after || keep_leans {
             clamp_overhang(&mut sections, 1, tan, enforce)
         } else {
             let (events, metrics) = clamp_overhang_measured(&mut sections, tan, enforce);
@@ -191,7 +193,7 @@ pub fn finish_sections(
         ));
     }
     // A wall of several beads steps across where the layers are level (see `seam`).
-    if design.shape.walls > 1 {
+    if seam_after {
         let seam = crate::seam::flattest_sample(
             &sections,
             design.printer.line_width,

@@ -142,8 +142,9 @@ pub struct SurfaceKey {
     pub bed: (BedShape, f64, f64, Origin),
     pub max_z: f64,
     pub center_given: bool,
-    /// A wall of several beads starts its sections at its seam ([`crate::seam`]).
-    pub several_beads: bool,
+    /// The wall's beads: a wall of several starts its sections at its seam, found for that many
+    /// beads ([`crate::seam`]).
+    pub beads: usize,
 }
 
 /// Inputs of the texture's displacement table: the texture and the section grid.
@@ -764,7 +765,7 @@ fn finish_stages(
         bed: (p.bed_shape, p.bed_x, p.bed_y, p.origin),
         max_z: p.max_z,
         center_given: design.shape.center.is_some(),
-        several_beads: design.shape.walls > 1,
+        beads: design.shape.walls.max(1),
     };
     let disp = design
         .texture
@@ -1189,7 +1190,8 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
             }
         );
         // Two beads: the surface (it starts at the beads' seam, see `seam`), the beads and the
-        // toolpath; a third bead, not the surface.
+        // toolpath; a third bead, the same (the seam is found for the beads' number: each turn
+        // rises a third of a layer, not a half).
         e.shape.walls = 2;
         let u = s.update(&e).unwrap();
         assert_eq!(
@@ -1208,6 +1210,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         assert_eq!(
             u,
             Update {
+                surface: true,
                 beads: true,
                 toolpath: true,
                 verdict: true,
@@ -1247,7 +1250,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         e.printer.max_overhang_deg = 40.0;
         assert!(s.update(&e).unwrap().wall_view);
         // A second bead: the mesh shows its inner sheet (the surface is made again, started at
-        // the beads' seam); a third, with the same surface.
+        // the beads' seam); a third, the same (the seam is found for the beads' number).
         e.shape.walls = 2;
         let u = s.update(&e).unwrap();
         assert!(u.wall_view && u.surface);
@@ -1255,7 +1258,7 @@ x = { wave = "sine", period = 10.0, amplitude = 0.8 }
         assert!(two > first.positions.len());
         e.shape.walls = 3;
         let u = s.update(&e).unwrap();
-        assert!(u.wall_view && !u.surface);
+        assert!(u.wall_view && u.surface);
         assert_eq!(s.wall_view().unwrap().positions.len(), two);
     }
 
