@@ -101,98 +101,48 @@ pub fn clamp_overhang(
     tan_limit: f64,
     enforce: bool,
 ) -> Vec<PointEvent> {
-    let clamp = Clamp {
-        tan_limit,
-        enforce,
-        measuring: Measuring::Nothing,
-    };
-    clamp_overhang_in(sections, from, clamp).0
+    clamp_overhang_in(sections, from, tan_limit, enforce, false).0
 }
 
 /// [`clamp_overhang`] from the first section up, with the [`measure`] of the sections it
-/// leaves (to the bit) and, when `keep_leans`, each point's lean as [`measure_with_leans`] gives
-/// it (else none), measured as each point is clamped: the normals of the section below and the
-/// points are at hand then, and a second pass over the surface is spared (on the benchmark
-/// vase, about a millisecond of the two cores; for a view's 360 × 200 wall, its drag's
-/// measure).
+/// leaves (to the bit), measured as each point is clamped: the normals of the section below
+/// and the points are at hand then, and a second pass over the surface is spared (on the
+/// benchmark vase, about a millisecond of the two cores).
 pub fn clamp_overhang_measured(
     sections: &mut [Section],
     tan_limit: f64,
     enforce: bool,
-    keep_leans: bool,
-) -> (Vec<PointEvent>, SurfaceMetrics, Vec<f32>) {
-    let measuring = if keep_leans {
-        Measuring::MetricsAndLeans
-    } else {
-        Measuring::Metrics
-    };
-    let clamp = Clamp {
-        tan_limit,
-        enforce,
-        measuring,
-    };
-    let (events, measured) = clamp_overhang_in(sections, 1, clamp);
+) -> (Vec<PointEvent>, SurfaceMetrics) {
+    let (events, metrics) = clamp_overhang_in(sections, 1, tan_limit, enforce, true);
     // Sections of different lengths are measured as [`measure`] measures them.
-    let (metrics, leans) = measured.unwrap_or_else(|| measure_in_parts(sections, keep_leans));
-    (events, metrics, leans)
+    let metrics = metrics.unwrap_or_else(|| measure(sections));
+    (events, metrics)
 }
 
-/// How a clamp clamps: the limit of `tan` of the lean, whether it moves points or only reports
-/// them, and what it measures of the sections it leaves.
-#[derive(Clone, Copy)]
-struct Clamp {
-    tan_limit: f64,
-    enforce: bool,
-    measuring: Measuring,
-}
-
-/// What a clamp measures as it goes ([`clamp_overhang_measured`]).
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Measuring {
-    Nothing,
-    /// The [`SurfaceMetrics`].
-    Metrics,
-    /// The metrics and each point's lean, section-major.
-    MetricsAndLeans,
-}
-
-impl Measuring {
-    fn metrics(self) -> bool {
-        self != Measuring::Nothing
-    }
-
-    fn leans(self) -> bool {
-        self == Measuring::MetricsAndLeans
-    }
-}
-
-/// What a clamp measured ([`Measuring`]): the metrics, and the leans where asked for (else
-/// none).
-type Measured = Option<(SurfaceMetrics, Vec<f32>)>;
-
-/// [`clamp_overhang`], with what `clamp.measuring` asks for where it can be measured as the
-/// points are clamped: from the first section (`from` ≤ 1), all as long.
+/// [`clamp_overhang`], with the metrics of the sections where `measuring` (from the first
+/// section: `from` ≤ 1) and they are all as long.
 fn clamp_overhang_in(
     sections: &mut [Section],
     from: usize,
-    mut clamp: Clamp,
-) -> (Vec<PointEvent>, Measured) {
+    tan_limit: f64,
+    enforce: bool,
+    measuring: bool,
+) -> (Vec<PointEvent>, Option<SurfaceMetrics>) {
     let start = from.max(1);
     let n = sections.first().map_or(0, |s| s.points.len());
     let rows = sections.len();
     let same_lengths = sections.iter().all(|s| s.points.len() == n);
-    if !(start == 1 && same_lengths) {
-        clamp.measuring = Measuring::Nothing;
-    }
+    let measuring = measuring && start == 1 && same_lengths;
     if start < rows && (rows - start) * n >= crate::parallel::PARALLEL_POINTS && same_lengths {
         let parts = crate::parallel::ranges(n, 2 * MIN_PART_COLUMNS);
         if parts.len() > 1
-            && let Some(clamped) = clamp_by_columns(sections, start, &parts, clamp)
+            && let Some(clamped) =
+                clamp_by_columns(sections, start, &parts, tan_limit, enforce, measuring)
         {
             return clamped;
         }
     }
-    clamp_by_rows(sections, from, clamp)
+    clamp_by_rows(sections, from, tan_limit, enforce, measuring)
 }
 
 /// Fewest columns a core takes in [`clamp_overhang`].
@@ -216,15 +166,10 @@ fn clamp_by_columns(
     sections: &mut [Section],
     start: usize,
     parts: &[std::ops::Range<usize>],
-    clamp: Clamp,
-) -> Option<(Vec<PointEvent>, Measured)> {
-    let Clamp {
-        tan_limit,
-        enforce,
-        measuring,
-    } = clamp;
-    let keep_leans = measuring.leans();
-    let measuring = measuring.metrics();
+    tan_limit: f64,
+    enforce: bool,
+    measuring: bool,
+) -> Option<(Vec<PointEvent>, Option<SurfaceMetrics>)> {
     use std::sync::OnceLock;
     use std::sync::atomic::{AtomicBool, Ordering};
     let count = parts.len();
@@ -298,11 +243,6 @@ fn clamp_by_columns(
                 if measuring {
                     rows[0].iter().for_each(|&p| metrics.add_bed_point(p));
                 }
-                // This part's columns' leans, row by row (the first on the bed, 0).
-                let mut leans = Vec::with_capacity(if keep_leans { rows.len() * w } else { 0 });
-                if keep_leans {
-                    leans.resize(w, 0.0);
-                }
                 let mut normals = Vec::with_capacity(w);
                 // The section below, with its neighbours' NEAR_COLUMNS points on either side.
                 let mut padded = Vec::with_capacity(w + 2 * NEAR_COLUMNS);
@@ -334,15 +274,7 @@ fn clamp_by_columns(
                             });
                         }
                         if measuring {
-                            let tan = metrics.add_point(
-                                *p,
-                                near[NEAR_COLUMNS],
-                                normals[c],
-                                &mut steepest,
-                            );
-                            if keep_leans {
-                                leans.push(lean_from_tan(tan));
-                            }
+                            metrics.add_point(*p, near[NEAR_COLUMNS], normals[c], &mut steepest);
                             z_range = (z_range.0.min(p.z), z_range.1.max(p.z));
                         }
                     }
@@ -351,18 +283,18 @@ fn clamp_by_columns(
                     }
                     let _ = edges[j][r].set(edges_of(cur));
                 }
-                (events, metrics, z_ranges, leans)
+                (events, metrics, z_ranges)
             }
         })
         .collect();
     let done = crate::parallel::run_together(jobs).ok()?;
-    let measured = measuring.then(|| {
+    let metrics = measuring.then(|| {
         let mut m = SurfaceMetrics::unmeasured();
-        for (_, part, _, _) in &done {
+        for (_, part, _) in &done {
             m.merge(part);
         }
         // Each section's z range, its parts' merged.
-        for r in 0..done.first().map_or(0, |(_, _, z, _)| z.len()) {
+        for r in 0..done.first().map_or(0, |(_, _, z)| z.len()) {
             let (lo, hi) = done
                 .iter()
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |z, d| {
@@ -370,26 +302,11 @@ fn clamp_by_columns(
                 });
             m.max_layer_z_range = m.max_layer_z_range.max(hi - lo);
         }
-        // Each section's leans, its parts' in column order.
-        let mut leans = Vec::with_capacity(if keep_leans { rows * n_all(parts) } else { 0 });
-        if keep_leans {
-            for r in 0..rows {
-                for ((_, _, _, part), columns) in done.iter().zip(parts) {
-                    let w = columns.len();
-                    leans.extend_from_slice(&part[r * w..(r + 1) * w]);
-                }
-            }
-        }
-        (m.finished(), leans)
+        m.finished()
     });
-    let mut events: Vec<PointEvent> = done.into_iter().flat_map(|(e, _, _, _)| e).collect();
+    let mut events: Vec<PointEvent> = done.into_iter().flat_map(|(e, _, _)| e).collect();
     events.sort_by_key(|e| (e.layer, e.sample));
-    Some((events, measured))
-}
-
-/// The columns of `parts` (contiguous from 0) together.
-fn n_all(parts: &[std::ops::Range<usize>]) -> usize {
-    parts.last().map_or(0, |r| r.end)
+    Some((events, metrics))
 }
 
 /// A part's first and last [`NEAR_COLUMNS`] points of a section, for the parts beside it.
@@ -528,25 +445,15 @@ fn with_slide_scaled(xy: DVec2, q: DVec2, n: DVec2, offset: f64, limit: f64) -> 
 fn clamp_by_rows(
     sections: &mut [Section],
     from: usize,
-    clamp: Clamp,
-) -> (Vec<PointEvent>, Measured) {
-    let Clamp {
-        tan_limit,
-        enforce,
-        measuring,
-    } = clamp;
-    let keep_leans = measuring.leans();
-    let measuring = measuring.metrics();
+    tan_limit: f64,
+    enforce: bool,
+    measuring: bool,
+) -> (Vec<PointEvent>, Option<SurfaceMetrics>) {
     let mut events = Vec::new();
     let mut padded = Vec::new();
     let (mut metrics, mut steepest) = (SurfaceMetrics::unmeasured(), 0.0);
-    let mut leans = Vec::new();
     if measuring && let Some(first) = sections.first() {
         first.points.iter().for_each(|&p| metrics.add_bed_point(p));
-        if keep_leans {
-            leans.reserve(sections.iter().map(|s| s.points.len()).sum());
-            leans.resize(first.points.len(), 0.0);
-        }
     }
     for k in from.max(1)..sections.len() {
         let (below, above) = sections.split_at_mut(k);
@@ -572,10 +479,7 @@ fn clamp_by_rows(
                 });
             }
             if measuring {
-                let tan = metrics.add_point(*p, below[NEAR_COLUMNS], normals[i], &mut steepest);
-                if keep_leans {
-                    leans.push(lean_from_tan(tan));
-                }
+                metrics.add_point(*p, below[NEAR_COLUMNS], normals[i], &mut steepest);
             }
         }
         if measuring {
@@ -583,14 +487,7 @@ fn clamp_by_rows(
             metrics.max_layer_z_range = metrics.max_layer_z_range.max(hi - lo);
         }
     }
-    (events, measuring.then(|| (metrics.finished(), leans)))
-}
-
-/// A point's lean kept for the view, degrees in single precision, from the `tan` of its lean
-/// ([`SurfaceMetrics::add_point`]'s): by [`atan_nonnegative`].
-#[inline]
-fn lean_from_tan(tan: f64) -> f32 {
-    atan_nonnegative(tan).to_degrees() as f32
+    (events, measuring.then(|| metrics.finished()))
 }
 
 /// Lean of the wall from vertical at point i of section k (k ≥ 1), degrees:
@@ -721,7 +618,7 @@ fn measure_part(
         for (i, p) in s.points.iter().enumerate() {
             let tan = m.add_point(*p, prev.points[i], normals[i], &mut steepest);
             if keep_leans {
-                leans.push(lean_from_tan(tan));
+                leans.push(atan_nonnegative(tan).to_degrees() as f32);
             }
         }
     }
@@ -732,15 +629,6 @@ fn measure_part(
 mod tests {
     use super::*;
     use glam::DVec3;
-
-    /// A clamp to `tan_limit` that measures nothing.
-    fn unmeasured(tan_limit: f64, enforce: bool) -> Clamp {
-        Clamp {
-            tan_limit,
-            enforce,
-            measuring: Measuring::Nothing,
-        }
-    }
 
     /// The window [`clamp_point`] reads, `below[NEAR_COLUMNS + j] = at(j)`.
     fn window(at: impl Fn(f64) -> DVec3) -> [DVec3; 2 * NEAR_COLUMNS + 1] {
@@ -846,7 +734,7 @@ mod tests {
         for enforce in [true, false] {
             for from in [1, 60] {
                 let mut by_rows = wall.clone();
-                let expected = clamp_by_rows(&mut by_rows, from, unmeasured(1.0, enforce)).0;
+                let expected = clamp_by_rows(&mut by_rows, from, 1.0, enforce, false).0;
                 assert!(expected.len() > 1000, "{}", expected.len());
                 let parts = crate::parallel::ranges(n, 2);
                 let parts = if parts.len() > 1 {
@@ -858,7 +746,7 @@ mod tests {
                 let (by_columns, events) = loop {
                     let mut by_columns = wall.clone();
                     if let Some(e) =
-                        clamp_by_columns(&mut by_columns, from, &parts, unmeasured(1.0, enforce))
+                        clamp_by_columns(&mut by_columns, from, &parts, 1.0, enforce, false)
                     {
                         break (by_columns, e.0);
                     }
@@ -873,7 +761,7 @@ mod tests {
         // once in a while under a loaded machine): many short runs on an oversubscribed machine.
         let short = &wall[..2];
         let mut by_rows = short.to_vec();
-        let expected = clamp_by_rows(&mut by_rows, 1, unmeasured(1.0, true)).0;
+        let expected = clamp_by_rows(&mut by_rows, 1, 1.0, true, false).0;
         let parts = vec![0..150, 150..300];
         let stop = std::sync::atomic::AtomicBool::new(false);
         std::thread::scope(|s| {
@@ -886,8 +774,7 @@ mod tests {
             }
             for _ in 0..20_000 {
                 let mut by_columns = short.to_vec();
-                if let Some(e) = clamp_by_columns(&mut by_columns, 1, &parts, unmeasured(1.0, true))
-                {
+                if let Some(e) = clamp_by_columns(&mut by_columns, 1, &parts, 1.0, true, false) {
                     assert_eq!((by_columns, e.0), (by_rows.clone(), expected.clone()));
                 }
             }
@@ -921,16 +808,14 @@ mod tests {
     proptest::proptest! {
         #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
 
-        /// Clamped and measured in one pass, the sections, the events, the metrics and the
-        /// leans kept (or none) are those of clamping and then measuring, to the bit: by columns
-        /// on both cores (walls of 720 points) and by rows (8 points), enforced or only
-        /// reported.
+        /// Clamped and measured in one pass, the sections, the events and the metrics are
+        /// those of clamping and then measuring, to the bit: by columns on both cores (walls of
+        /// 720 points) and by rows (8 points), enforced or only reported.
         #[test]
         fn measured_as_clamped_is_clamped_then_measured(
             rows in 2usize..40,
             wide in proptest::bool::ANY,
             enforce in proptest::bool::ANY,
-            keep_leans in proptest::bool::ANY,
             wobble in 0.0..3.0f64,
             lobes in 1u32..9,
             seed in 0u64..1000,
@@ -950,22 +835,18 @@ mod tests {
                 .collect();
             let (mut a, mut b) = (sections.clone(), sections);
             let plain = clamp_overhang(&mut a, 1, 1.0, enforce);
-            let (events, metrics, leans) = clamp_overhang_measured(&mut b, 1.0, enforce, keep_leans);
+            let (events, metrics) = clamp_overhang_measured(&mut b, 1.0, enforce);
             let bits = |s: &[Section]| -> Vec<[u64; 3]> {
                 s.iter().flat_map(|s| s.points.iter().map(|p| p.to_array().map(f64::to_bits))).collect()
             };
             proptest::prop_assert_eq!(bits(&a), bits(&b));
             proptest::prop_assert_eq!(plain, events);
-            let (m, measured_leans) = measure_in_parts(&a, keep_leans);
+            let m = measure(&a);
             let exact = |m: SurfaceMetrics| {
                 [m.max_overhang_deg, m.max_layer_z_range, m.min_layer_height, m.max_layer_height,
                  m.xy_box.0.x, m.xy_box.0.y, m.xy_box.1.x, m.xy_box.1.y, m.top].map(f64::to_bits)
             };
             proptest::prop_assert_eq!(exact(metrics), exact(m));
-            // Every point's lean where kept (section-major, section 0 at 0), none where not.
-            let lean_bits = |l: &[f32]| l.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            proptest::prop_assert_eq!(leans.len(), if keep_leans { rows * n } else { 0 });
-            proptest::prop_assert_eq!(lean_bits(&leans), lean_bits(&measured_leans));
         }
 
         /// The largest lean is the exact one of the point-by-point scan, to the bit, and every

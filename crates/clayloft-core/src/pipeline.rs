@@ -174,15 +174,14 @@ pub fn finish_sections(
             findings.append(&mut f);
         }
         // Safety net: whatever the column scaling missed (normals turn with the texture). The
-        // wall is measured as it is clamped (each point's lean too, for a view) where nothing
-        // moves it after.
+        // wall is measured as it is clamped where nothing moves it after and no point's lean
+        // is kept.
         let tan = overhang_tan_limit(design) / LIMIT_MARGIN;
-        let residual = if seam_after {
+        let residual = if seam_after || keep_leans {
             clamp_overhang(&mut sections, 1, tan, enforce)
         } else {
-            let (events, metrics, leans) =
-                clamp_overhang_measured(&mut sections, tan, enforce, keep_leans);
-            measured = Some((metrics, leans));
+            let (events, metrics) = clamp_overhang_measured(&mut sections, tan, enforce);
+            measured = Some(metrics);
             events
         };
         findings.extend(group_events(
@@ -204,7 +203,7 @@ pub fn finish_sections(
         crate::seam::start_at(&mut sections, seam);
     }
     let (metrics, point_leans_deg) = match measured {
-        Some(measured) => measured,
+        Some(metrics) => (metrics, Vec::new()),
         None if keep_leans => measure_with_leans(&sections),
         None => (measure(&sections), Vec::new()),
     };
