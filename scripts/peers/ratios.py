@@ -127,8 +127,8 @@ for where, runs in placed.items():
         print(f"clayloft, cores {where}: median {m:.1f} ms ({len(runs)} runs): "
               f"{median['prusaslicer'] / m:.0f}x prusaslicer, "
               f"{median['fullcontrol'] / m:.0f}x fullcontrol (the peers' medians)")
-if firsts:
-    rest = [ms for i, ms in enumerate(times["clayloft"]) if i % args.clayloft_runs != 0]
+rest = [ms for i, ms in enumerate(times["clayloft"]) if i % args.clayloft_runs != 0]
+if firsts and rest:
     print(f"clayloft, first run after the peers: median {statistics.median(firsts):.1f} ms "
           f"({len(firsts)} runs); runs after its own: median {statistics.median(rest):.1f} ms "
           f"({len(rest)} runs)")
