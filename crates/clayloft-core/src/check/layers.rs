@@ -582,7 +582,8 @@ enum Search {
     NearFirst,
     /// The whole box always.
     WholeBox,
-    /// Every earlier chord, without the grid or its prefilters: the reference.
+    /// Every earlier chord, without the grid or its prefilters, for every point (the path's
+    /// first layer too, see [`nothing_under_until`]): the reference.
     EveryChord,
     /// The near box first, as `NearFirst`, with the chords found under their boxes
     /// ([`ChordTree`]) instead of in the grid's columns (the self-check's).
@@ -687,6 +688,11 @@ fn measure_layers_in(
         bed_layer: limits.max_layer_height + 0.01 * limits.max_layer_height + 0.002,
         inside: &inside,
         every_chord: search == Search::EveryChord,
+        // The reference searches every point.
+        nothing_under_until: match search {
+            Search::EveryChord => 0,
+            _ => nothing_under_until(v, below_tol),
+        },
     };
     let budget = CANDIDATES_BASE.saturating_add(CANDIDATES_PER_POINT.saturating_mul(v.len()));
     let shown = first_show && measurable && search.proves_all(budget, layer_limits);
@@ -1146,6 +1152,26 @@ struct LayerSearch<'a, F: Fn(DVec3) -> bool + Sync> {
     inside: &'a F,
     /// Search every earlier chord instead of the grid (see [`Search::EveryChord`]).
     every_chord: bool,
+    /// Points before this one have no point before them low enough to lie under them
+    /// ([`nothing_under_until`]): the path's first layer, on the bed.
+    nothing_under_until: usize,
+}
+
+/// The first point of path `v` that some point up to it lies at least `below_tol` under (less
+/// 10⁻⁹ mm, for the rounding of a spot's height between a chord's ends, which lies between
+/// them): every point before it has no chord laid before it with a spot in its search's
+/// heights (`below_tol` or more under it), so nothing lies under it but, maybe, the bed. The
+/// path's first layer: the benchmark vase's first 2 878 points, each of which the search
+/// found nothing under after searching the whole box around it (0.7 µs a point, 2 ms of
+/// processor time in its proof).
+fn nothing_under_until(v: &[DVec3], below_tol: f64) -> usize {
+    let mut lowest = f64::INFINITY;
+    v.iter()
+        .position(|p| {
+            lowest = lowest.min(p.z);
+            lowest <= p.z - below_tol + 1e-9
+        })
+        .unwrap_or(v.len())
 }
 
 /// Points a task of the layer search takes ([`LayerSearch::all`], [`LayerSearch::proves_all`]):
@@ -1420,6 +1446,9 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         if j == 0 || !(self.inside)(p) {
             return (Below::Skipped, None);
         }
+        if j < self.nothing_under_until {
+            return (self.below(p, Found::NONE), None);
+        }
         let found = if self.every_chord {
             self.every_chord(j)
         } else {
@@ -1656,6 +1685,25 @@ mod tests {
     use super::*;
     use crate::design::Printer;
     use proptest::prelude::*;
+
+    /// The first layer ends at the first point a tolerance above the lowest before it: a flat
+    /// ring at 0.5 mm, then a rise. A path that only comes down never rises above what it
+    /// laid before, nor does one that rises less than the tolerance.
+    #[test]
+    fn nothing_lies_under_the_points_before_the_first_a_tolerance_up() {
+        let at = |zs: &[f64]| -> Vec<DVec3> {
+            zs.iter()
+                .enumerate()
+                .map(|(i, &z)| DVec3::new(i as f64, 0.0, z))
+                .collect()
+        };
+        let tol = 0.1;
+        assert_eq!(nothing_under_until(&at(&[0.5, 0.5, 0.55, 0.59, 0.61, 0.5]), tol), 4);
+        assert_eq!(nothing_under_until(&at(&[2.0, 1.95, 1.9, 1.8]), tol), 4);
+        assert_eq!(nothing_under_until(&at(&[2.0, 1.8, 1.85, 1.91]), tol), 3);
+        assert_eq!(nothing_under_until(&at(&[0.5, 0.58, 0.52]), tol), 3);
+        assert_eq!(nothing_under_until(&[], tol), 0);
+    }
 
     /// A spiral wall whose radius follows `r(z)` with a wobble: leans from vertical to past the
     /// limit, steps between revolutions, a few points off the wall.
