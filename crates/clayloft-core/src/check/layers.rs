@@ -1698,7 +1698,10 @@ mod tests {
                 .collect()
         };
         let tol = 0.1;
-        assert_eq!(nothing_under_until(&at(&[0.5, 0.5, 0.55, 0.59, 0.61, 0.5]), tol), 4);
+        assert_eq!(
+            nothing_under_until(&at(&[0.5, 0.5, 0.55, 0.59, 0.61, 0.5]), tol),
+            4
+        );
         assert_eq!(nothing_under_until(&at(&[2.0, 1.95, 1.9, 1.8]), tol), 4);
         assert_eq!(nothing_under_until(&at(&[2.0, 1.8, 1.85, 1.91]), tol), 3);
         assert_eq!(nothing_under_until(&at(&[0.5, 0.58, 0.52]), tol), 3);
