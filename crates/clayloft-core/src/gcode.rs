@@ -202,11 +202,14 @@ fn summarize_beside<T: Send>(
     let tp = &job.toolpath;
     let moves = JobMoves::new(design, tp);
     let plan = motion::Plan::new(moves.home, &moves, p.max_acceleration, p.junction_deviation);
+    // The path's segments are the planner's moves after the approach.
+    let a = moves.approach.len();
+    let path_segments = a..a + tp.points.len().saturating_sub(1);
+    // Each segment's time and volume on both cores, then what is summed in path order on
+    // this one while the other draws the thumbnails.
+    let steps = PathSums::steps(design, tp, plan.lengths().get(path_segments.clone()));
     let (other, (time, sums)) = crate::parallel::both(use_beside, beside, || {
-        // The path's segments are the planner's moves after the approach.
-        let a = moves.approach.len();
-        let segments = plan.lengths().get(a..a + tp.points.len().saturating_sub(1));
-        let sums = PathSums::of(design, tp, segments);
+        let sums = PathSums::of_steps(design, tp, plan.lengths().get(path_segments), steps);
         (plan.time(), sums)
     });
     let summary = JobSummary {
@@ -659,7 +662,48 @@ impl PathSums {
     /// The sums of `tp`'s points, each added in path order as the body's writer adds them;
     /// `segments[i − 1]` is `|p_i − p_{i−1}|` where given (the planner's, the same to the bit:
     /// the difference's coordinates are the same up to their signs), else measured here.
+    #[cfg(test)]
     fn of(design: &Design, tp: &Toolpath, segments: Option<&[f64]>) -> PathSums {
+        let steps = Self::steps(design, tp, segments);
+        Self::of_steps(design, tp, segments, steps)
+    }
+
+    /// Each segment's time at its point's speed and its volume, `(dt, volume)` for the
+    /// segment to point i at i − 1: what [`PathSums::of_steps`] sums, on every core for a long
+    /// path (each value depends on its segment alone, so the sums in path order stay the same
+    /// to the bit). For the benchmark vase a third of the sums' time, which the thumbnails'
+    /// core then waited for.
+    fn steps(design: &Design, tp: &Toolpath, segments: Option<&[f64]>) -> Vec<(f64, f64)> {
+        let points = &tp.points;
+        let count = points.len().saturating_sub(1);
+        let mut steps = Vec::with_capacity(count);
+        crate::parallel::for_each_part(
+            &mut steps.spare_capacity_mut()[..count],
+            crate::parallel::PARALLEL_POINTS,
+            |offset, part| {
+                for (i, step) in (offset + 1..).zip(part) {
+                    let d = match segments {
+                        Some(lengths) => lengths[i - 1],
+                        None => points[i - 1].pos.distance(points[i].pos),
+                    };
+                    step.write((d / points[i].speed, segment_volume(design, tp, i)));
+                }
+            },
+        );
+        // SAFETY: the parts cover the room's `count` places, and each part writes each of its
+        // places above.
+        unsafe { steps.set_len(count) };
+        steps
+    }
+
+    /// The sums of `tp`'s points from their `steps` ([`PathSums::steps`]), each added in path
+    /// order as the body's writer adds them (see [`PathSums::of`]).
+    fn of_steps(
+        design: &Design,
+        tp: &Toolpath,
+        segments: Option<&[f64]>,
+        mut steps: Vec<(f64, f64)>,
+    ) -> PathSums {
         let p = &design.printer;
         let e_per_mm3 = e_per_mm3(p);
         let absolute = p.extrusion == ExtrusionMode::Absolute;
@@ -673,7 +717,6 @@ impl PathSums {
         let mut starts = vec![BodyState::START];
         let mut percent_times = vec![None];
         let mut percent_before = None;
-        let mut steps = Vec::with_capacity(n.saturating_sub(1));
         for i in 1..n {
             let q = &points[i];
             if (i - 1) % BODY_CHUNK == 0 && i > 1 {
@@ -686,15 +729,15 @@ impl PathSums {
                 None => points[i - 1].pos.distance(q.pos),
             };
             length += d;
-            let dt = d / q.speed;
+            let (dt, v) = steps[i - 1];
             st.t_done += dt;
-            let v = segment_volume(design, tp, i);
             volume += v;
             let e = v * e_per_mm3;
             if absolute {
                 st.e_total += e;
             }
-            steps.push((dt, e));
+            // The segment's E in place of its volume.
+            steps[i - 1].1 = e;
             (lo, hi) = (lo.min(q.pos), hi.max(q.pos));
             st.last_speed = q.speed;
             while st.next_layer < tp.layer_starts.len() && tp.layer_starts[st.next_layer] <= i {
@@ -1138,16 +1181,18 @@ mod tests {
     /// The path's sums in one pass are the toolpath's own to the last bit: its length, its time
     /// at its own speeds, the clay's volume and its box (a spiral whose speeds change: its upper
     /// layers slowed to the minimum layer time; on a base, whose first point is the lowest).
+    /// Long enough for each segment's time and volume to be worked out on every core.
     #[test]
     fn the_path_sums_are_the_paths_own() {
         let mut d = crate::load::parse_design(
-            "version = 1\n[shape]\nheight = 20.0\nbase_layers = 2\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 36.0 }\n[printer]\nmin_layer_time = 30.0\n",
+            "version = 1\n[shape]\nheight = 60.0\nsamples = 720\nbase_layers = 2\nlower = { type = \"circle\", radius = 30.0 }\nupper = { type = \"circle\", radius = 36.0 }\n[printer]\nmin_layer_time = 30.0\n",
         )
         .unwrap();
         for a in [500.0, 5.0] {
             d.printer.max_acceleration = a;
             let job = crate::run(&d).unwrap();
             let tp = &job.toolpath;
+            assert!(tp.points.len() > 2 * crate::parallel::PARALLEL_POINTS);
             assert!(tp.points.windows(2).any(|w| w[0].speed != w[1].speed));
             let (summary, sums, ()) = summarize_beside(&d, &job, true, || ());
             assert_eq!(summary.path_length_mm.to_bits(), tp.length().to_bits());
