@@ -418,7 +418,8 @@ fn droops_in(
     let sections = &surface.sections;
     let mut out = Vec::new();
     for k in ks {
-        let (below, here) = (sections[k - 1].xy(), sections[k].xy());
+        // The rings' points read in XY where they lie (no copies of the rings).
+        let (below, here) = (&sections[k - 1].points, &sections[k].points);
         let n = here.len();
         if n < 3 || below.len() != n {
             continue;
@@ -439,7 +440,12 @@ fn droops_in(
                 j as usize % n
             };
             let k = if j + 1 == n { 0 } else { j + 1 };
-            within(here[i], below[j], below[k], half)
+            within(
+                here[i].truncate(),
+                below[j].truncate(),
+                below[k].truncate(),
+                half,
+            )
         };
         let supported_within = |i: usize, reach: usize| {
             (0..reach as isize).any(|m| chord_within(i, m) || chord_within(i, -m - 1))
@@ -457,11 +463,11 @@ fn droops_in(
         for s in 1..=n {
             let (a, b) = ((start + s - 1) % n, (start + s) % n);
             if free[b] {
-                run += here[a].distance(here[b]);
+                run += here[a].truncate().distance(here[b].truncate());
             } else {
                 if run > 0.0 {
                     // The gap reaches to the supported point on either side.
-                    run += here[a].distance(here[b]);
+                    run += here[a].truncate().distance(here[b].truncate());
                 }
                 longest = longest.max(run);
                 run = 0.0;
