@@ -659,9 +659,7 @@ struct PathSums {
 }
 
 impl PathSums {
-    /// The sums of `tp`'s points, each added in path order as the body's writer adds them;
-    /// `segments[i − 1]` is `|p_i − p_{i−1}|` where given (the planner's, the same to the bit:
-    /// the difference's coordinates are the same up to their signs), else measured here.
+    /// [`PathSums::of_steps`] of [`PathSums::steps`]: the whole sums in one call (the tests').
     #[cfg(test)]
     fn of(design: &Design, tp: &Toolpath, segments: Option<&[f64]>) -> PathSums {
         let steps = Self::steps(design, tp, segments);
@@ -697,7 +695,9 @@ impl PathSums {
     }
 
     /// The sums of `tp`'s points from their `steps` ([`PathSums::steps`]), each added in path
-    /// order as the body's writer adds them (see [`PathSums::of`]).
+    /// order as the body's writer adds them; `segments[i − 1]` is `|p_i − p_{i−1}|` where given
+    /// (the planner's, the same to the bit: the difference's coordinates are the same up to
+    /// their signs), else measured here.
     fn of_steps(
         design: &Design,
         tp: &Toolpath,

@@ -18,7 +18,7 @@ mod tree;
 use tree::ChordTree;
 
 /// Points a chord may span. Chords stand for runs of nearly collinear path points (see
-/// [`chords`]); the cap bounds the work of building one.
+/// [`chords_and_lengths`]); the cap bounds the work of building one.
 const MAX_POINTS_PER_CHORD: usize = 64;
 /// How far a chord may deviate from the points it stands for, mm: below the 1 µm rounding of
 /// G-code coordinates' effect on any measured angle, far below a bead.
@@ -422,18 +422,20 @@ const BAND_RETRY: usize = 16;
 /// the blocks are found on every core and the chords are the same whatever their number.
 const CHORD_BLOCK: usize = 1 << 15;
 
-/// The path as chords `(i, k)`: each stands for path points `i ..= k`, all within
-/// [`CHORD_TOLERANCE_MM`] of the straight line from point `i` to point `k` (at most
-/// [`MAX_POINTS_PER_CHORD`] points, and never across a multiple of [`CHORD_BLOCK`]). A finely
-/// sampled curve becomes chords about a millimetre long, whatever its sampling; a hostile file
-/// that zig-zags in one spot stays one chord per point but its cells are capped.
+/// The chords of path `v` (see [`chords_and_lengths`]), for the tests.
 #[cfg(test)]
 pub(super) fn chords(v: &[DVec3]) -> Vec<(usize, usize)> {
     chords_and_lengths(v).0
 }
 
-/// The chords of path `v` (see [`chords`]) and its length up to each point, mm: block by
-/// block on every core.
+/// The path `v` as chords `(i, k)`, and its length up to each point, mm: block by block on
+/// every core.
+///
+/// A chord stands for path points `i ..= k`, all within [`CHORD_TOLERANCE_MM`] of the straight
+/// line from point `i` to point `k` (at most [`MAX_POINTS_PER_CHORD`] points, and never across
+/// a multiple of [`CHORD_BLOCK`]). A finely sampled curve becomes chords about a millimetre
+/// long, whatever its sampling; a hostile file that zig-zags in one spot stays one chord per
+/// point but its cells are capped.
 ///
 /// The running length is summed within each block and the blocks' totals are added after, in
 /// path order: the same sums whatever the number of cores.
@@ -502,8 +504,8 @@ fn chords_and_lengths(v: &[DVec3]) -> (Vec<(usize, usize)>, Vec<f64>) {
     (chords, cum)
 }
 
-/// Writes the chords of path points `first ..= last` (see [`chords`]) to the start of `room`
-/// (one place a segment); how many there are.
+/// Writes the chords of path points `first ..= last` (see [`chords_and_lengths`]) to the
+/// start of `room` (one place a segment); how many there are.
 fn chords_in(
     v: &[DVec3],
     first: usize,
