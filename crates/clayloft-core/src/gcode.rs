@@ -188,10 +188,10 @@ pub fn summarize(design: &Design, job: &PrintJob) -> JobSummary {
 /// [`summarize`], with `beside` (the writer's thumbnails) run on a second core (when
 /// `use_beside` and one is free) while this one sums the path in one pass ([`PathSums`], each
 /// segment's time and volume worked out on both cores first) and runs the motion planner's
-/// look-ahead passes (its entry limits use both cores first); with the path's sums. For the benchmark vase the thumbnails and the estimate took 9.3 ms with
-/// the thumbnails beside the whole planner, 6 ms so; the path's sums (its length, time,
-/// volume and box, and each body chunk's start) were five passes, one of them after
-/// `beside`, before they were one.
+/// look-ahead passes (its entry limits use both cores first); with the path's sums. For the
+/// benchmark vase the thumbnails and the estimate took 9.3 ms with the thumbnails beside the
+/// whole planner, 6 ms so; the path's sums (its length, time, volume and box, and each body
+/// chunk's start) were five passes, one of them after `beside`, before they were one.
 fn summarize_beside<T: Send>(
     design: &Design,
     job: &PrintJob,

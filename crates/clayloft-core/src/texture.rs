@@ -159,10 +159,8 @@ fn apply_in_runs(
             let pair = (&sections[k].points[..], &sections[k - 1].points[..]);
             lessen(&mut scale, pair, (&faded[0], below), k, tan_limit);
         }
-        for (s, &(allowed, k)) in scale.iter_mut().zip(least) {
-            if allowed < s.0 {
-                *s = (allowed, k);
-            }
+        for (s, &candidate) in scale.iter_mut().zip(least) {
+            keep_least(s, candidate);
         }
     }
     let folds = faded_runs
@@ -250,9 +248,15 @@ fn lessen(
             (faded.shifts[c], faded_below.shifts[c]),
             tan_limit,
         );
-        if allowed < l.0 {
-            *l = (allowed, k);
-        }
+        keep_least(l, (allowed, k));
+    }
+}
+
+/// `least` lowered to `candidate` where that is strictly less: of two equal scales the one
+/// met first, from a lower layer, stays.
+fn keep_least(least: &mut Least, candidate: Least) {
+    if candidate.0 < least.0 {
+        *least = candidate;
     }
 }
 
