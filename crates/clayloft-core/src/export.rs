@@ -48,7 +48,8 @@ pub enum ExportError {
     Unreadable { file: String, error: GcodeError },
     /// The program breaks a limit of its printer: the worst-reported violation.
     #[error(
-        "does not print on this printer ({printer}): {what} at {count} points{worst} ({detail}); {}",
+        "does not print on this printer ({printer}): {what} at {count} {}{worst} ({detail}); {}",
+        if *count == 1 { "point" } else { "points" },
         advice(what)
     )]
     Refused {
@@ -287,6 +288,25 @@ mod tests {
         // A loop: the shape, not the printer.
         let loops = advice(CROSSING);
         assert!(!loops.contains("finer bead") && loops.contains("shallower texture"));
+    }
+
+    /// A refusal at one point says "1 point" (it said "1 points").
+    #[test]
+    fn a_refusal_counts_its_points_in_words() {
+        let refused = |count| ExportError::Refused {
+            printer: "the paper's printer".into(),
+            what: "layer too thin",
+            count,
+            worst: ", worst 0.02 mm short".into(),
+            detail: "below min_layer_height 0.25 mm".into(),
+        };
+        let said = refused(1).to_string();
+        assert!(
+            said.contains("layer too thin at 1 point, worst 0.02 mm short"),
+            "{said}"
+        );
+        let said = refused(3).to_string();
+        assert!(said.contains("layer too thin at 3 points, worst"), "{said}");
     }
 
     /// A refusal says how far the worst point is past the limit, in the limit's own unit: a

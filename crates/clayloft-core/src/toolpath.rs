@@ -466,8 +466,22 @@ fn build_toolpath_split(
 
     // 4. Levelled rim: a flat turn at the top section's height on each bead, while the layer
     //    under it is at least min_layer_height thinner (the innermost bead's turn stops where it
-    //    is not, as a one-bead rim does, and at the latest one sample before its seam).
+    //    is not, as a one-bead rim does, and at the latest one sample before its seam). The
+    //    layer under a rim point is measured as the checker measures it: from the highest spot
+    //    of the bead's last turn within half a bead (where the wall leans, the turn below rises
+    //    along the path beside the point, not only under it).
     let start = b.points.len();
+    // What the rim rests on: the last revolution (none before the first: the rim then lies on
+    // the flat layer), as the checker finds it.
+    let under_rim = (layers > first)
+        .then(|| layer_starts.last().map(|&r| &b.points[r..start]))
+        .flatten()
+        .map(|revolution| {
+            let limits = crate::check::Limits::from(p);
+            RimSupport::new(revolution, 0.5 * p.line_width, &limits)
+        });
+    let mut rim_length = 0.0;
+    let mut rim_last = b.points.last().map(|q| q.pos.truncate());
     'rim: for (t, bead) in beads.iter().enumerate() {
         let top = &bead[layers];
         let last = t + 1 == walls;
@@ -475,12 +489,22 @@ fn build_toolpath_split(
         for i in i0..=i1 {
             let j = i % n;
             let q = top.points[j];
+            rim_length += rim_last.map_or(0.0, |l| l.distance(q.truncate()));
+            rim_last = Some(q.truncate());
+            let beside = under_rim
+                .as_ref()
+                .and_then(|under| under.top_under(q, rim_length, a));
             let thickness = q.z - z_below[t][j];
             // Only while the step onto the rim is a printable layer: with horizontal control
             // lines the top section is not level, and where it climbs faster than the last
             // revolution the rim would be a layer thicker than the printer lays (or a bead in
-            // the air).
-            if thickness < a || thickness > p.max_layer_height {
+            // the air). And while the checker finds it thick enough beside the point too (the
+            // clay laid is for the bead's own layer below, as on the helix).
+            let beside_thin = under_rim
+                .as_ref()
+                .zip(beside)
+                .is_some_and(|(under, z)| q.z - z < under.thinnest);
+            if thickness < a || beside_thin || thickness > p.max_layer_height {
                 break 'rim;
             }
             b.push(q, thickness);
@@ -708,6 +732,176 @@ impl Helix<'_> {
             }
         }
         std::mem::swap(below, z_now);
+    }
+}
+
+/// How much thicker than the checker's thinnest the layer beside a rim point must be, mm: the
+/// checker measures between chords within 2 µm of the path and the G-code rounds coordinates
+/// to half a micrometre.
+const RIM_SPARE_MM: f64 = 0.003;
+
+/// The layer under the levelled rim as the checker measures it (`check::layers`): the highest
+/// spot of the last revolution within half a bead of a rim point. The revolution is cut into
+/// the checker's chords (runs of points within 2 µm of a straight line); a spot is the foot of
+/// the perpendicular from the point on a chord beside it (on it, within half its length past
+/// an end, or outside a sharp corner), at least a quarter of a thin layer under the point
+/// ([`crate::check::same_layer_tolerance`]). Where the wall leans, the revolution below rises
+/// along the path beside the point, not only under it; across a notch narrower than a bead it
+/// lies on both sides. Spots on the bead just laid (the end of the revolution, up to
+/// [`crate::check::just_laid_gap`] of path behind the point, further along it than half that
+/// across and less than a thin layer under it) are passed over, as the checker passes them.
+/// The chords are kept in a grid of cells at least half a bead wide, so each point reads the
+/// few chords of the cells around it.
+struct RimSupport {
+    /// The revolution's points (copied: the rim is laid after them).
+    path: Vec<DVec3>,
+    /// The chords, as (first point, last point).
+    chords: Vec<(usize, usize)>,
+    /// Path length from each point to the revolution's end, mm.
+    to_end: Vec<f64>,
+    half_bead: f64,
+    gap: f64,
+    same_layer: f64,
+    /// The thinnest layer under a rim point, mm: the checker's, with [`RIM_SPARE_MM`] to spare.
+    thinnest: f64,
+    origin: DVec2,
+    cell: f64,
+    cols: usize,
+    rows: usize,
+    /// Chord ids in each cell a chord's box covers: cell c's in `ids[starts[c]..starts[c + 1]]`.
+    starts: Vec<usize>,
+    ids: Vec<usize>,
+}
+
+impl RimSupport {
+    /// Cells per side at most (a wider path gets wider cells).
+    const MAX_CELLS: usize = 256;
+
+    fn new(path: &[PathPoint], half_bead: f64, limits: &crate::check::Limits) -> Self {
+        let path: Vec<DVec3> = path.iter().map(|q| q.pos).collect();
+        let chords = crate::check::chords_of(&path);
+        let (lo, hi) = crate::geometry::bounds(path.iter().map(|q| q.truncate()));
+        let extent = (hi - lo).max_element().max(1e-9);
+        let cell = half_bead.max(extent / Self::MAX_CELLS as f64).max(1e-9);
+        let (cols, rows) = (
+            ((hi.x - lo.x) / cell) as usize + 1,
+            ((hi.y - lo.y) / cell) as usize + 1,
+        );
+        let mut to_end = vec![0.0; path.len()];
+        for i in (0..path.len().saturating_sub(1)).rev() {
+            to_end[i] = to_end[i + 1] + path[i].distance(path[i + 1]);
+        }
+        let mut grid = RimSupport {
+            path,
+            chords,
+            to_end,
+            half_bead,
+            gap: crate::check::just_laid_gap(limits),
+            same_layer: crate::check::same_layer_tolerance(limits),
+            thinnest: crate::check::thinnest_layer_accepted(limits) + RIM_SPARE_MM,
+            origin: lo,
+            cell,
+            cols,
+            rows,
+            starts: vec![0; cols * rows + 1],
+            ids: Vec::new(),
+        };
+        // Counted, then placed.
+        let cells_of = |g: &RimSupport, id: usize| {
+            let (ia, ib) = g.chords[id];
+            let (a, b) = (g.path[ia].truncate(), g.path[ib].truncate());
+            let (c0, r0) = g.cell_of(a.min(b));
+            let (c1, r1) = g.cell_of(a.max(b));
+            (r0..=r1).flat_map(move |r| (c0..=c1).map(move |c| r * cols + c))
+        };
+        for id in 0..grid.chords.len() {
+            for c in cells_of(&grid, id) {
+                grid.starts[c + 1] += 1;
+            }
+        }
+        for c in 0..cols * rows {
+            grid.starts[c + 1] += grid.starts[c];
+        }
+        let mut next = grid.starts.clone();
+        let mut ids = vec![0; grid.starts[cols * rows]];
+        for id in 0..grid.chords.len() {
+            for c in cells_of(&grid, id) {
+                ids[next[c]] = id;
+                next[c] += 1;
+            }
+        }
+        grid.ids = ids;
+        grid
+    }
+
+    /// The cell holding `p` (clamped to the grid).
+    fn cell_of(&self, p: DVec2) -> (usize, usize) {
+        let at = ((p - self.origin) / self.cell).max(DVec2::ZERO);
+        (
+            (at.x as usize).min(self.cols - 1),
+            (at.y as usize).min(self.rows - 1),
+        )
+    }
+
+    /// Whether `p`, at `f_line` along chord `id` (more than half its length past an end), lies
+    /// more than half a length past that end of the chord beyond it too: outside the tip of a
+    /// sharp corner, where the corner is the spot under it.
+    fn past_corner(&self, id: usize, f_line: f64, p: DVec2) -> bool {
+        let other = if f_line > 1.5 {
+            id.checked_add(1)
+        } else {
+            id.checked_sub(1)
+        };
+        let Some(&(ia, ib)) = other.and_then(|k| self.chords.get(k)) else {
+            return false;
+        };
+        let (a, b) = (self.path[ia].truncate(), self.path[ib].truncate());
+        let len2 = (b - a).length_squared();
+        if len2 == 0.0 {
+            return false;
+        }
+        let g = (p - a).dot(b - a) / len2;
+        if f_line > 1.5 { g < -0.5 } else { g > 1.5 }
+    }
+
+    /// The highest spot under rim point `q`, `along` mm of rim after the revolution's end, `None`
+    /// where there is none within half a bead; `thin` is the thinnest layer.
+    fn top_under(&self, q: DVec3, along: f64, thin: f64) -> Option<f64> {
+        let p = q.truncate();
+        let (c0, r0) = self.cell_of(p - self.half_bead);
+        let (c1, r1) = self.cell_of(p + self.half_bead);
+        let mut top: Option<f64> = None;
+        for r in r0..=r1 {
+            let (first, last) = (r * self.cols + c0, r * self.cols + c1);
+            for &id in &self.ids[self.starts[first]..self.starts[last + 1]] {
+                let (ia, ib) = self.chords[id];
+                let (a, b) = (self.path[ia], self.path[ib]);
+                let ab = b.truncate() - a.truncate();
+                let len2 = ab.length_squared();
+                let f_line = if len2 > 0.0 {
+                    (p - a.truncate()).dot(ab) / len2
+                } else {
+                    0.0
+                };
+                let f = f_line.clamp(0.0, 1.0);
+                let d = p.distance(a.truncate() + ab * f);
+                let beside = (-0.5..=1.5).contains(&f_line) || self.past_corner(id, f_line, p);
+                if d > self.half_bead || !beside {
+                    continue;
+                }
+                let zq = a.z + (b.z - a.z) * f;
+                if q.z - zq < self.same_layer {
+                    continue;
+                }
+                let behind =
+                    along + self.to_end[ib] + (1.0 - f) * (self.to_end[ia] - self.to_end[ib]);
+                if behind < self.gap && d >= 0.5 * behind && q.z - zq < thin {
+                    continue;
+                }
+                top = Some(top.map_or(zq, |t: f64| t.max(zq)));
+            }
+        }
+        top
     }
 }
 
@@ -1114,6 +1308,85 @@ mod tests {
         let report = crate::check::check_path(&points, &crate::check::Limits::from(&d.printer));
         assert!(report.ok(), "{report}");
         job
+    }
+
+    /// Found by random designs (2026-12-07, seed 1178): an ellipse foot lofted to a four-pointed
+    /// star. The levelled rim stopped where the layer under it, measured at the same sample of
+    /// the last revolution, grew thinner than the printer's thinnest; but at a notch of the
+    /// star the last revolution comes back within half a bead on the notch's far side, higher
+    /// up the spiral, and the checker measured a layer 0.235 mm thin two points before the
+    /// rim's end: the self-check refused the design. The rim now stops where the checker's
+    /// measure says so too.
+    #[test]
+    fn the_rim_stops_where_the_checker_finds_the_layer_beside_it_too_thin() {
+        let d = parse_design(
+            r#"version = 1
+[printer]
+layer_height = 1.0
+[shape]
+height = 84.1
+samples = 200
+base_layers = 2
+[shape.lower]
+type = "ellipse"
+rx = 63.16
+ry = 24.73
+[shape.upper]
+type = "star"
+points = 4
+outer_radius = 23.39
+inner_radius = 7.83
+[[control.vertical]]
+points = [[0.0, 0.0], [0.11, 14.8], [0.45, 0.6], [1.0, 0.0]]
+angle = 301.3
+width = 90.8
+"#,
+        )
+        .unwrap();
+        let job = run_and_check(&d);
+        // The rim is still there: most of a revolution at the top section's height.
+        let top = job.toolpath.points.last().unwrap().pos.z;
+        let rim = job
+            .toolpath
+            .points
+            .iter()
+            .rev()
+            .take_while(|q| q.pos.z == top)
+            .count();
+        assert!((100..200).contains(&rim), "{rim} rim points");
+    }
+
+    /// The layer under a rim point as the checker finds it: a path below that runs out along
+    /// y = 0 and back along y = 1 (a hairpin, rising 0.1 mm a point) has, under (5, 0.5), the
+    /// outward run's foot 0.5 mm high and the return's 1.5 mm high: the higher counts. Within
+    /// half a bead of nothing, nothing; the end of the path just laid, passed over until the rim
+    /// is a gap's length past it.
+    #[test]
+    fn the_layer_under_a_rim_point_is_the_highest_spot_beside_it() {
+        let point = |x: f64, y: f64, z: f64| PathPoint {
+            pos: DVec3::new(x, y, z),
+            thickness: 1.0,
+            flow: 1.0,
+            speed: 20.0,
+        };
+        let out = (0..=10).map(|i| point(i as f64, 0.0, 0.1 * i as f64));
+        let back = (0..=10).map(|i| point(10.0 - i as f64, 1.0, 1.0 + 0.1 * i as f64));
+        let path: Vec<PathPoint> = out.chain(back).collect();
+        let limits = crate::check::Limits::from(&crate::design::Printer::default());
+        let under = RimSupport::new(&path, 1.5, &limits);
+        let top = under.top_under(DVec3::new(5.0, 0.5, 2.5), 100.0, 0.25);
+        assert!((top.unwrap() - 1.5).abs() < 1e-12, "{top:?}");
+        assert_eq!(
+            under.top_under(DVec3::new(5.0, 5.0, 2.5), 100.0, 0.25),
+            None
+        );
+        // Just past the path's end (0, 1, 2), 0.1 mm above it: the bead just laid is passed
+        // over; the outward run's start, 2.1 mm under, is what lies below.
+        let top = under.top_under(DVec3::new(-0.5, 1.0, 2.1), 0.5, 0.25);
+        assert_eq!(top, Some(0.0));
+        // Further along the rim, the same spot is the layer below.
+        let top = under.top_under(DVec3::new(-0.5, 1.0, 2.1), 50.0, 0.25);
+        assert_eq!(top, Some(2.0));
     }
 
     /// Found by random designs (2026-12-06, seed 130): an ellipse lofted to a rounded heptagon,

@@ -504,6 +504,18 @@ fn chords_and_lengths(v: &[DVec3]) -> (Vec<(usize, usize)>, Vec<f64>) {
     (chords, cum)
 }
 
+/// The chords of path `v` (see [`chords_and_lengths`]), on this core: for a short path.
+pub(crate) fn chords_of(v: &[DVec3]) -> Vec<(usize, usize)> {
+    let segments = v.len().saturating_sub(1);
+    let mut room = vec![std::mem::MaybeUninit::uninit(); segments];
+    let count = chords_in(v, 0, segments, &mut room);
+    room[..count]
+        .iter()
+        // SAFETY: `chords_in` wrote the first `count` places.
+        .map(|c| unsafe { c.assume_init() })
+        .collect()
+}
+
 /// Writes the chords of path points `first ..= last` (see [`chords_and_lengths`]) to the
 /// start of `room` (one place a segment); how many there are.
 fn chords_in(
@@ -601,9 +613,9 @@ fn measure_layers_in(
     measured: Option<ClearanceRun>,
 ) -> bool {
     let tan_max = limits.max_overhang_deg.to_radians().tan();
-    let radius = limits.line_width + 2.0 * limits.max_layer_height * tan_max;
-    let gap = 3.0 * radius;
-    let below_tol = 0.25 * limits.min_layer_height;
+    let radius = search_radius(limits);
+    let gap = just_laid_gap(limits);
+    let below_tol = same_layer_tolerance(limits);
     let layer_limits = LayerLimits::of(limits);
     let stepped_up = limits.min_layer_height - layer_limits.height_tol;
     let reach = 2.0 * limits.max_layer_height + below_tol;
@@ -1154,6 +1166,34 @@ struct LayerSearch<'a, F: Fn(DVec3) -> bool + Sync> {
     /// Points before this one have no point before them low enough to lie under them
     /// ([`nothing_under_until`]): the path's first layer, on the bed.
     nothing_under_until: usize,
+}
+
+/// How far across from a point the layer search looks for what lies below it, mm: a bead, and
+/// the lean of two of the thickest layers at the overhang limit.
+fn search_radius(limits: &Limits) -> f64 {
+    let tan_max = limits.max_overhang_deg.to_radians().tan();
+    limits.line_width + 2.0 * limits.max_layer_height * tan_max
+}
+
+/// The thinnest layer the search accepts, mm: the printer's thinnest, less the tolerance of a
+/// measure between chords that stand for the path within [`CHORD_TOLERANCE_MM`].
+pub(crate) fn thinnest_layer_accepted(limits: &Limits) -> f64 {
+    let layer = LayerLimits::of(limits);
+    layer.min_height - layer.height_tol
+}
+
+/// A spot less than this under a point is at its own height, not a layer below it, mm: a
+/// quarter of the thinnest layer.
+pub(crate) fn same_layer_tolerance(limits: &Limits) -> f64 {
+    0.25 * limits.min_layer_height
+}
+
+/// Path length, mm, within which a spot behind a point along an almost straight stretch of path
+/// is the bead just laid, not the layer below (see [`LayerSearch::spot`]): three search radii.
+/// The spot is passed over when it also lies at least half its length along the path across
+/// from the point and less than a thin layer under it.
+pub(crate) fn just_laid_gap(limits: &Limits) -> f64 {
+    3.0 * search_radius(limits)
 }
 
 /// The first point of path `v` that some point up to it lies at least `below_tol` under (less

@@ -23,9 +23,10 @@ impl fmt::Display for Violation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "VIOLATION {}: {} moves{}, first at line {} ({})",
+            "VIOLATION {}: {} {}{}, first at line {} ({})",
             self.what,
             self.count,
+            if self.count == 1 { "move" } else { "moves" },
             self.worst_said(3),
             self.first_line,
             self.detail
@@ -181,5 +182,29 @@ impl Tally {
         }
         self.count += 1;
         self.worst = self.worst.max(value);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One move is "1 move", more are "moves" (a refusal quoted "1 moves").
+    #[test]
+    fn a_violation_counts_its_moves_in_words() {
+        let mut v = Violation {
+            what: "layer too thin",
+            count: 1,
+            worst: 0.015,
+            unit: " mm short",
+            first_line: 20421,
+            detail: "below min_layer_height 0.25 mm".into(),
+        };
+        assert_eq!(
+            v.to_string(),
+            "VIOLATION layer too thin: 1 move, worst 0.015 mm short, first at line 20421 (below min_layer_height 0.25 mm)"
+        );
+        v.count = 2;
+        assert!(v.to_string().contains(": 2 moves, worst"), "{v}");
     }
 }
