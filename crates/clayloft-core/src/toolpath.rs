@@ -843,27 +843,6 @@ impl RimSupport {
         )
     }
 
-    /// Whether `p`, at `f_line` along chord `id` (more than half its length past an end), lies
-    /// more than half a length past that end of the chord beyond it too: outside the tip of a
-    /// sharp corner, where the corner is the spot under it.
-    fn past_corner(&self, id: usize, f_line: f64, p: DVec2) -> bool {
-        let other = if f_line > 1.5 {
-            id.checked_add(1)
-        } else {
-            id.checked_sub(1)
-        };
-        let Some(&(ia, ib)) = other.and_then(|k| self.chords.get(k)) else {
-            return false;
-        };
-        let (a, b) = (self.path[ia].truncate(), self.path[ib].truncate());
-        let len2 = (b - a).length_squared();
-        if len2 == 0.0 {
-            return false;
-        }
-        let g = (p - a).dot(b - a) / len2;
-        if f_line > 1.5 { g < -0.5 } else { g > 1.5 }
-    }
-
     /// The highest spot under rim point `q`, `along` mm of rim after the revolution's end, `None`
     /// where there is none within half a bead; `thin` is the thinnest layer.
     fn top_under(&self, q: DVec3, along: f64, thin: f64) -> Option<f64> {
@@ -885,7 +864,8 @@ impl RimSupport {
                 };
                 let f = f_line.clamp(0.0, 1.0);
                 let d = p.distance(a.truncate() + ab * f);
-                let beside = (-0.5..=1.5).contains(&f_line) || self.past_corner(id, f_line, p);
+                let beside = (-0.5..=1.5).contains(&f_line)
+                    || crate::check::past_corner(&self.path, &self.chords, id, f_line, p);
                 if d > self.half_bead || !beside {
                     continue;
                 }

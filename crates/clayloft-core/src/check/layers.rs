@@ -1175,6 +1175,33 @@ fn search_radius(limits: &Limits) -> f64 {
     limits.line_width + 2.0 * limits.max_layer_height * tan_max
 }
 
+/// Whether `p`, at `f_line` along chord `id` of path `v` (more than half its length past one of
+/// its ends), lies more than half a length past that end of the chord beyond it too: outside
+/// the tip of a sharp corner (see [`LayerSearch::past_corner`]).
+pub(crate) fn past_corner(
+    v: &[DVec3],
+    chords: &[(usize, usize)],
+    id: usize,
+    f_line: f64,
+    p: DVec2,
+) -> bool {
+    let other = if f_line > 1.5 {
+        id.checked_add(1)
+    } else {
+        id.checked_sub(1)
+    };
+    let Some(&(ia, ib)) = other.and_then(|k| chords.get(k)) else {
+        return false;
+    };
+    let (a, b) = (v[ia].truncate(), v[ib].truncate());
+    let len2 = (b - a).length_squared();
+    if len2 == 0.0 {
+        return false;
+    }
+    let g = (p - a).dot(b - a) / len2;
+    if f_line > 1.5 { g < -0.5 } else { g > 1.5 }
+}
+
 /// The thinnest layer the search accepts, mm: the printer's thinnest, less the tolerance of a
 /// measure between chords that stand for the path within [`CHORD_TOLERANCE_MM`].
 pub(crate) fn thinnest_layer_accepted(limits: &Limits) -> f64 {
@@ -1650,21 +1677,7 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
     /// path, which neither chord at the corner has beside it. There the corner is the spot
     /// under p (within half a bead: on the bead's round end).
     fn past_corner(&self, id: usize, f_line: f64, p: DVec2) -> bool {
-        let other = if f_line > 1.5 {
-            id.checked_add(1)
-        } else {
-            id.checked_sub(1)
-        };
-        let Some(&(ia, ib)) = other.and_then(|k| self.chords.get(k)) else {
-            return false;
-        };
-        let (a, b) = (self.v[ia].truncate(), self.v[ib].truncate());
-        let len2 = (b - a).length_squared();
-        if len2 == 0.0 {
-            return false;
-        }
-        let g = (p - a).dot(b - a) / len2;
-        if f_line > 1.5 { g < -0.5 } else { g > 1.5 }
+        past_corner(self.v, self.chords, id, f_line, p)
     }
 
     /// Adds to `found` the spot of chord `id` under point j, when it is one (see

@@ -20,7 +20,9 @@
 
 mod crossings;
 mod layers;
-pub(crate) use layers::{chords_of, just_laid_gap, same_layer_tolerance, thinnest_layer_accepted};
+pub(crate) use layers::{
+    chords_of, just_laid_gap, past_corner, same_layer_tolerance, thinnest_layer_accepted,
+};
 mod limits;
 mod moves;
 mod report;
