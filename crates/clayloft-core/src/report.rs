@@ -43,10 +43,17 @@ impl fmt::Display for Finding {
         } else {
             "VIOLATION"
         };
+        let (first, last) = self.layers;
+        if first == last {
+            write!(f, "{verb}: layer {first}, ")?;
+        } else {
+            write!(f, "{verb}: layers {first}–{last}, ")?;
+        }
+        let points = if self.points == 1 { "point" } else { "points" };
         write!(
             f,
-            "{verb}: layers {}–{}, {} points, up to {:.2} mm: {}",
-            self.layers.0, self.layers.1, self.points, self.amount_mm, self.message
+            "{} {points}, up to {:.2} mm: {}",
+            self.points, self.amount_mm, self.message
         )
     }
 }
@@ -118,6 +125,11 @@ mod tests {
         assert!(
             f[0].to_string()
                 .starts_with("corrected: layers 3–5, 3 points")
+        );
+        // One layer, one point: said so ("layers 40–40, 1 points" before).
+        assert_eq!(
+            f[1].to_string(),
+            "corrected: layer 40, 1 point, up to 0.10 mm: max 0.1"
         );
     }
 }
