@@ -467,9 +467,9 @@ fn build_toolpath_split(
     // 4. Levelled rim: a flat turn at the top section's height on each bead, while the layer
     //    under it is at least min_layer_height thinner (the innermost bead's turn stops where it
     //    is not, as a one-bead rim does, and at the latest one sample before its seam). The
-    //    layer under a rim point is measured as the checker measures it: from the highest spot
-    //    of the bead's last turn within half a bead (where the wall leans, the turn below rises
-    //    along the path beside the point, not only under it).
+    //    layer under a rim point is also measured as the checker measures it: from the highest
+    //    spot of the last revolution within half a bead (where the wall leans, the revolution
+    //    below rises along the path beside the point, not only under it).
     let start = b.points.len();
     // What the rim rests on: the last revolution (none before the first: the rim then lies on
     // the flat layer), as the checker finds it.
