@@ -493,7 +493,7 @@ fn build_toolpath_split(
             rim_last = Some(q.truncate());
             let beside = under_rim
                 .as_ref()
-                .and_then(|under| under.top_under(q, rim_length, a));
+                .and_then(|under| under.top_under(q, rim_length));
             let thickness = q.z - z_below[t][j];
             // Only while the step onto the rim is a printable layer: with horizontal control
             // lines the top section is not level, and where it climbs faster than the last
@@ -762,6 +762,9 @@ struct RimSupport {
     half_bead: f64,
     gap: f64,
     same_layer: f64,
+    /// The printer's thinnest layer, mm: a spot on the bead just laid less than this under the
+    /// point is passed over.
+    min_layer: f64,
     /// The thinnest layer under a rim point, mm: the checker's, with [`RIM_SPARE_MM`] to spare.
     thinnest: f64,
     origin: DVec2,
@@ -798,6 +801,7 @@ impl RimSupport {
             half_bead,
             gap: crate::check::just_laid_gap(limits),
             same_layer: crate::check::same_layer_tolerance(limits),
+            min_layer: limits.min_layer_height,
             thinnest: crate::check::thinnest_layer_accepted(limits) + RIM_SPARE_MM,
             origin: lo,
             cell,
@@ -844,8 +848,8 @@ impl RimSupport {
     }
 
     /// The highest spot under rim point `q`, `along` mm of rim after the revolution's end, `None`
-    /// where there is none within half a bead; `thin` is the thinnest layer.
-    fn top_under(&self, q: DVec3, along: f64, thin: f64) -> Option<f64> {
+    /// where there is none within half a bead.
+    fn top_under(&self, q: DVec3, along: f64) -> Option<f64> {
         let p = q.truncate();
         let (c0, r0) = self.cell_of(p - self.half_bead);
         let (c1, r1) = self.cell_of(p + self.half_bead);
@@ -875,7 +879,7 @@ impl RimSupport {
                 }
                 let behind =
                     along + self.to_end[ib] + (1.0 - f) * (self.to_end[ia] - self.to_end[ib]);
-                if behind < self.gap && d >= 0.5 * behind && q.z - zq < thin {
+                if behind < self.gap && d >= 0.5 * behind && q.z - zq < self.min_layer {
                     continue;
                 }
                 top = Some(top.map_or(zq, |t: f64| t.max(zq)));
@@ -1354,18 +1358,15 @@ width = 90.8
         let path: Vec<PathPoint> = out.chain(back).collect();
         let limits = crate::check::Limits::from(&crate::design::Printer::default());
         let under = RimSupport::new(&path, 1.5, &limits);
-        let top = under.top_under(DVec3::new(5.0, 0.5, 2.5), 100.0, 0.25);
+        let top = under.top_under(DVec3::new(5.0, 0.5, 2.5), 100.0);
         assert!((top.unwrap() - 1.5).abs() < 1e-12, "{top:?}");
-        assert_eq!(
-            under.top_under(DVec3::new(5.0, 5.0, 2.5), 100.0, 0.25),
-            None
-        );
+        assert_eq!(under.top_under(DVec3::new(5.0, 5.0, 2.5), 100.0), None);
         // Just past the path's end (0, 1, 2), 0.1 mm above it: the bead just laid is passed
         // over; the outward run's start, 2.1 mm under, is what lies below.
-        let top = under.top_under(DVec3::new(-0.5, 1.0, 2.1), 0.5, 0.25);
+        let top = under.top_under(DVec3::new(-0.5, 1.0, 2.1), 0.5);
         assert_eq!(top, Some(0.0));
         // Further along the rim, the same spot is the layer below.
-        let top = under.top_under(DVec3::new(-0.5, 1.0, 2.1), 50.0, 0.25);
+        let top = under.top_under(DVec3::new(-0.5, 1.0, 2.1), 50.0);
         assert_eq!(top, Some(2.0));
     }
 
