@@ -11,6 +11,7 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::check::ChordFoot;
 use crate::design::Design;
 use crate::pipeline::Surface;
 use crate::report::{Finding, FindingKind};
@@ -744,12 +745,14 @@ const RIM_SPARE_MM: f64 = 0.003;
 /// spot of the last revolution within half a bead of a rim point. The revolution is cut into
 /// the checker's chords (runs of points within 2 µm of a straight line); a spot is the foot of
 /// the perpendicular from the point on a chord beside it (on it, within half its length past
-/// an end, or outside a sharp corner), at least a quarter of a thin layer under the point
+/// an end, or outside a sharp corner: the checker's own [`crate::check::foot_under`]), at least
+/// a quarter of a thin layer under the point
 /// ([`crate::check::same_layer_tolerance`]). Where the wall leans, the revolution below rises
 /// along the path beside the point, not only under it; across a notch narrower than a bead it
 /// lies on both sides. Spots on the bead just laid (the end of the revolution, up to
 /// [`crate::check::just_laid_gap`] of path behind the point, further along it than half that
-/// across and less than a thin layer under it) are passed over, as the checker passes them.
+/// across and less than a thin layer under it: [`crate::check::on_bead_just_laid`]) are passed
+/// over, as the checker passes them.
 /// The chords are kept in a grid of cells at least half a bead wide, so each point reads the
 /// few chords of the cells around it.
 struct RimSupport {
@@ -857,29 +860,23 @@ impl RimSupport {
         for r in r0..=r1 {
             let (first, last) = (r * self.cols + c0, r * self.cols + c1);
             for &id in &self.ids[self.starts[first]..self.starts[last + 1]] {
-                let (ia, ib) = self.chords[id];
-                let (a, b) = (self.path[ia], self.path[ib]);
-                let ab = b.truncate() - a.truncate();
-                let len2 = ab.length_squared();
-                let f_line = if len2 > 0.0 {
-                    (p - a.truncate()).dot(ab) / len2
-                } else {
-                    0.0
-                };
-                let f = f_line.clamp(0.0, 1.0);
-                let d = p.distance(a.truncate() + ab * f);
-                let beside = (-0.5..=1.5).contains(&f_line)
-                    || crate::check::past_corner(&self.path, &self.chords, id, f_line, p);
-                if d > self.half_bead || !beside {
+                let Some(ChordFoot { f, d, z: zq }) = crate::check::foot_under(
+                    &self.path,
+                    &self.chords,
+                    id,
+                    p,
+                    self.half_bead,
+                    self.half_bead,
+                ) else {
                     continue;
-                }
-                let zq = a.z + (b.z - a.z) * f;
+                };
                 if q.z - zq < self.same_layer {
                     continue;
                 }
+                let (ia, ib) = self.chords[id];
                 let behind =
                     along + self.to_end[ib] + (1.0 - f) * (self.to_end[ia] - self.to_end[ib]);
-                if behind < self.gap && d >= 0.5 * behind && q.z - zq < self.min_layer {
+                if crate::check::on_bead_just_laid(behind, d, q.z - zq, self.gap, self.min_layer) {
                     continue;
                 }
                 top = Some(top.map_or(zq, |t: f64| t.max(zq)));

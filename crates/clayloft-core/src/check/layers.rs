@@ -74,7 +74,7 @@ impl ColumnChord {
     ///
     /// Passes too chords with an end within √`end2` of `p` (see [`end_reach2`]): a point on
     /// the bead's round end, past a sharp corner of the layer below (see
-    /// [`LayerSearch::past_corner`]).
+    /// [`past_corner`]).
     ///
     /// And false when the chord lies wholly above or below the heights `z` (low, high) a layer
     /// under the point may have (the bead just laid, mostly).
@@ -1177,7 +1177,8 @@ fn search_radius(limits: &Limits) -> f64 {
 
 /// Whether `p`, at `f_line` along chord `id` of path `v` (more than half its length past one of
 /// its ends), lies more than half a length past that end of the chord beyond it too: outside
-/// the tip of a sharp corner (see [`LayerSearch::past_corner`]).
+/// the tip of a sharp corner of the path, which neither chord at the corner has beside it.
+/// There the corner is the spot under `p` (within half a bead: on the bead's round end).
 pub(crate) fn past_corner(
     v: &[DVec3],
     chords: &[(usize, usize)],
@@ -1200,6 +1201,69 @@ pub(crate) fn past_corner(
     }
     let g = (p - a).dot(b - a) / len2;
     if f_line > 1.5 { g < -0.5 } else { g > 1.5 }
+}
+
+/// Where chord `id` of path `v` lies under the point `p` (in XY), as the layer search measures
+/// it: the foot of the perpendicular at `f` along the chord (clamped to it), `d` across from
+/// `p`, at height `z` there; `None` where the chord is more than `radius` across, or where the
+/// foot lies more than half the chord's length past its ends (a chord ahead of or behind `p`
+/// along its own direction is beside `p`, not under it) unless `p` is within `half_bead` and
+/// outside the tip of a sharp corner there ([`past_corner`]).
+#[inline]
+pub(crate) fn foot_under(
+    v: &[DVec3],
+    chords: &[(usize, usize)],
+    id: usize,
+    p: DVec2,
+    radius: f64,
+    half_bead: f64,
+) -> Option<ChordFoot> {
+    let (ia, ib) = chords[id];
+    let (a, b) = (v[ia], v[ib]);
+    let (a2, b2) = (a.truncate(), b.truncate());
+    let ab = b2 - a2;
+    let len2 = ab.length_squared();
+    let f_line = if len2 > 0.0 {
+        (p - a2).dot(ab) / len2
+    } else {
+        0.0
+    };
+    // `point_segment_distance` with the fraction along the line above.
+    let f = f_line.clamp(0.0, 1.0);
+    let d = p.distance(a2 + ab * f);
+    if d > radius
+        || !((-0.5..=1.5).contains(&f_line)
+            || d <= half_bead && past_corner(v, chords, id, f_line, p))
+    {
+        return None;
+    }
+    Some(ChordFoot {
+        f,
+        d,
+        z: a.z + (b.z - a.z) * f,
+    })
+}
+
+/// The foot of the perpendicular on a chord under a point ([`foot_under`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ChordFoot {
+    /// Fraction along the chord, 0 … 1.
+    pub f: f64,
+    /// Distance across from the point, mm.
+    pub d: f64,
+    /// Height of the chord there, mm.
+    pub z: f64,
+}
+
+/// Whether a spot `behind` mm back along the path from a point, `d` across from it and `rise`
+/// under it, is the bead just laid rather than the layer below (see [`LayerSearch::spot`]): it
+/// is within `gap` along an almost straight stretch of path (at least half as far across as
+/// along) and less than a thin layer (`stepped_up`) under the point. Where the path has come
+/// back over itself the layer below is much nearer in XY than along the path; where it has
+/// stepped up a whole layer on the way, what it left is the layer below.
+#[inline]
+pub(crate) fn on_bead_just_laid(behind: f64, d: f64, rise: f64, gap: f64, stepped_up: f64) -> bool {
+    behind < gap && d >= 0.5 * behind && rise < stepped_up
 }
 
 /// The thinnest layer the search accepts, mm: the printer's thinnest, less the tolerance of a
@@ -1672,14 +1736,6 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
         (self.inside)(a) && (self.inside)(b) && !steep(a, b)
     }
 
-    /// Whether `p`, at `f_line` along chord `id` (past one of its ends), lies past the end of
-    /// the chord on the other side of that end too: outside the tip of a sharp corner of the
-    /// path, which neither chord at the corner has beside it. There the corner is the spot
-    /// under p (within half a bead: on the bead's round end).
-    fn past_corner(&self, id: usize, f_line: f64, p: DVec2) -> bool {
-        past_corner(self.v, self.chords, id, f_line, p)
-    }
-
     /// Adds to `found` the spot of chord `id` under point j, when it is one (see
     /// [`LayerSearch::spot`]).
     fn add_spot(&self, j: usize, id: usize, z: [f64; 2], found: &mut Found) {
@@ -1689,43 +1745,24 @@ impl<F: Fn(DVec3) -> bool + Sync> LayerSearch<'_, F> {
     }
 
     /// The spot of chord `id` under point j, its height and distance across, when it is one:
-    /// the foot of the perpendicular on or near the chord, within `radius` across, at a height
-    /// within `z` (low, high), and not on the bead just laid.
+    /// the foot of the perpendicular on or near the chord, within `radius` across
+    /// ([`foot_under`]), at a height within `z` (low, high), and not on the bead just laid
+    /// ([`on_bead_just_laid`]).
     #[inline]
     fn spot(&self, j: usize, id: usize, z: [f64; 2]) -> Option<(f64, f64)> {
         let p = self.v[j];
-        let pxy = p.truncate();
+        let ChordFoot { f, d, z: zq } = foot_under(
+            self.v,
+            self.chords,
+            id,
+            p.truncate(),
+            self.radius,
+            self.half_bead,
+        )?;
         let (ia, ib) = self.chords[id];
-        let (a, b) = (self.v[ia], self.v[ib]);
-        // Distance across the segment's line, for feet of the perpendicular on the segment or
-        // just past its ends; a segment entirely ahead of or behind p along its own direction
-        // is beside p, not under it.
-        let (a2, b2) = (a.truncate(), b.truncate());
-        let ab = b2 - a2;
-        let len2 = ab.length_squared();
-        let f_line = if len2 > 0.0 {
-            (pxy - a2).dot(ab) / len2
-        } else {
-            0.0
-        };
-        // `point_segment_distance` with the fraction along the line above.
-        let f = f_line.clamp(0.0, 1.0);
-        let d = pxy.distance(a2 + ab * f);
-        if d > self.radius
-            || !((-0.5..=1.5).contains(&f_line)
-                || d <= self.half_bead && self.past_corner(id, f_line, pxy))
-        {
-            return None;
-        }
-        let zq = a.z + (b.z - a.z) * f;
-        // The bead just laid: reached from p along an almost straight stretch of path. Where
-        // the path has come back over itself (the next revolution, the centre of a spiral base)
-        // the layer below is much nearer in XY than along the path; where it has stepped up a
-        // whole layer on the way (a base's next layer starting a layer up and out, under a wall
-        // flaring at 45° with beads of 5 mm), what it left is the layer below.
         let cum = self.cum;
         let along = cum[j] - (cum[ia] + f * (cum[ib] - cum[ia]));
-        if along < self.gap && d >= 0.5 * along && p.z - zq < self.stepped_up {
+        if on_bead_just_laid(along, d, p.z - zq, self.gap, self.stepped_up) {
             return None;
         }
         (zq <= z[1] && zq >= z[0]).then_some((zq, d))

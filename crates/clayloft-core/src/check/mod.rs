@@ -21,7 +21,8 @@
 mod crossings;
 mod layers;
 pub(crate) use layers::{
-    chords_of, just_laid_gap, past_corner, same_layer_tolerance, thinnest_layer_accepted,
+    ChordFoot, chords_of, foot_under, just_laid_gap, on_bead_just_laid, same_layer_tolerance,
+    thinnest_layer_accepted,
 };
 mod limits;
 mod moves;
