@@ -308,6 +308,21 @@ const POWERS_OF_TEN: [u64; 20] = {
     t
 };
 
+/// `v` as a program writes it with `D` decimals and a reader reads it back
+/// ([`Line::fixed_const`]: rounded half away from zero): what the checker of a written program
+/// measures.
+pub(crate) fn as_written<const D: u32>(v: f64) -> f64 {
+    let x = v.abs() * 10u64.pow(D) as f64;
+    // Not a number, or past the integers formatted: written by the formatter, as it is.
+    if x.is_nan() || x >= 9.0e18 {
+        return v;
+    }
+    let whole = x.trunc();
+    let n = whole + if x - whole >= 0.5 { 1.0 } else { 0.0 };
+    let read = n / EXACT_POWERS[D as usize];
+    if v < 0.0 && n != 0.0 { -read } else { read }
+}
+
 /// Appends `v` with exactly `decimals` digits after the point to `buf` (see [`Line::fixed`]).
 pub fn put_fixed(buf: &mut Vec<u8>, v: f64, decimals: u32) {
     Line::append(buf, |line| {
@@ -323,6 +338,32 @@ mod tests {
         let mut b = Vec::new();
         put_fixed(&mut b, v, d);
         String::from_utf8(b).unwrap()
+    }
+
+    /// A number as written with three decimals is what the program's text reads back as, to the
+    /// bit: halves away from zero, a negative rounded to nothing written as 0.
+    #[test]
+    fn as_written_is_what_the_text_reads_back() {
+        for v in [
+            0.0,
+            0.0005,
+            1.0005,
+            -2.0015,
+            57.8205,
+            140.794_499_9,
+            -0.0004,
+            123.456_789,
+            -99.9995,
+            1e-9,
+            250.0,
+        ] {
+            let text = fixed(v, 3);
+            assert_eq!(
+                as_written::<3>(v).to_bits(),
+                parse_f64(&text).unwrap().to_bits(),
+                "{v}: {text}"
+            );
+        }
     }
 
     /// The text as the standard library's formatter writes it, rounded half away from zero with

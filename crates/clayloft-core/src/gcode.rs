@@ -13,6 +13,10 @@ use glam::DVec3;
 
 use crate::decimal::Line;
 pub use crate::decimal::put_fixed;
+
+/// Decimals of the moves' X, Y and Z (a micrometre): what the printer is told, and what the
+/// self-check measures.
+pub const XYZ_DECIMALS: u32 = 3;
 use crate::design::{BedShape, Design, Dialect, ExtrusionMode, Kinematics, Origin};
 use crate::motion;
 use crate::pipeline::PrintJob;
@@ -1022,11 +1026,11 @@ impl<'a> BodyWriter<'a> {
             st.t_done += dt;
             let (x, y, z, e) = Line::append(buf, |line| {
                 line.text(b"G1 X");
-                let x = number::<3>(line, q.pos.x - ox, MOVES);
+                let x = number::<XYZ_DECIMALS>(line, q.pos.x - ox, MOVES);
                 line.text(b" Y");
-                let y = number::<3>(line, q.pos.y - oy, MOVES);
+                let y = number::<XYZ_DECIMALS>(line, q.pos.y - oy, MOVES);
                 line.text(b" Z");
-                let z = number::<3>(line, q.pos.z, MOVES);
+                let z = number::<XYZ_DECIMALS>(line, q.pos.z, MOVES);
                 line.text(b" E");
                 let e = match p.extrusion {
                     ExtrusionMode::Relative => number::<5>(line, e, MOVES),

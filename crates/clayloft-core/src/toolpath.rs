@@ -479,7 +479,7 @@ fn build_toolpath_split(
         .flatten()
         .map(|revolution| {
             let limits = crate::check::Limits::from(p);
-            RimSupport::new(revolution, 0.5 * p.line_width, &limits)
+            RimSupport::new(revolution, 0.5 * p.line_width, &limits, p.origin_offset())
         });
     let mut rim_length = 0.0;
     let mut rim_last = b.points.last().map(|q| q.pos.truncate());
@@ -745,7 +745,8 @@ const RIM_SPARE_MM: f64 = 0.003;
 /// spot of the last revolution within half a bead of a rim point. The revolution is cut into
 /// the checker's chords (runs of points within 2 µm of a straight line); a spot is the foot of
 /// the perpendicular from the point on a chord beside it (on it, within half its length past
-/// an end, or outside a sharp corner: the checker's own [`crate::check::foot_under`]), at least
+/// an end, or outside a sharp corner: the checker's own [`crate::check::chord_foot`],
+/// [`crate::check::within_window`] and [`crate::check::past_corner`]), at least
 /// a quarter of a thin layer under the point
 /// ([`crate::check::same_layer_tolerance`]). Where the wall leans, the revolution below rises
 /// along the path beside the point, not only under it; across a notch narrower than a bead it
@@ -758,8 +759,16 @@ const RIM_SPARE_MM: f64 = 0.003;
 struct RimSupport {
     /// The revolution's points (copied: the rim is laid after them).
     path: Vec<DVec3>,
-    /// The chords, as (first point, last point).
+    /// The chords, as (first point, last point), as the checker would cut this revolution.
     chords: Vec<(usize, usize)>,
+    /// The chords the checker could cut from the revolution, as far as a rim point within half
+    /// a bead can tell ([`crate::check::chords_beside`]): it cuts the whole path, so its
+    /// chords of this revolution start wherever those before them ended. A point's spot is the
+    /// highest on any.
+    every: Vec<(usize, usize)>,
+    /// The place in `chords` of each of `every` that is one of them (for the corner rule, which
+    /// reads the chords before and after).
+    in_chords: Vec<Option<usize>>,
     /// Path length from each point to the revolution's end, mm.
     to_end: Vec<f64>,
     half_bead: f64,
@@ -783,9 +792,35 @@ impl RimSupport {
     /// Cells per side at most (a wider path gets wider cells).
     const MAX_CELLS: usize = 256;
 
-    fn new(path: &[PathPoint], half_bead: f64, limits: &crate::check::Limits) -> Self {
-        let path: Vec<DVec3> = path.iter().map(|q| q.pos).collect();
+    /// The support of the revolution `path`, as the G-code writes it on a printer whose origin
+    /// lies at `origin` in the bed's frame: the checker measures the program's coordinates,
+    /// rounded to the micrometre, and a few more points of them can fit a chord than of the
+    /// path as computed (random design 1337: a chord of two segments, where the path has two
+    /// of one, reached back 1.2 mm past its start to a point 0.1 mm higher).
+    fn new(
+        path: &[PathPoint],
+        half_bead: f64,
+        limits: &crate::check::Limits,
+        origin: [f64; 2],
+    ) -> Self {
+        use crate::decimal::as_written;
+        use crate::gcode::XYZ_DECIMALS;
+        let [ox, oy] = origin;
+        let path: Vec<DVec3> = path
+            .iter()
+            .map(|q| {
+                let p = q.pos;
+                DVec3::new(
+                    as_written::<XYZ_DECIMALS>(p.x - ox) + ox,
+                    as_written::<XYZ_DECIMALS>(p.y - oy) + oy,
+                    as_written::<XYZ_DECIMALS>(p.z),
+                )
+            })
+            .collect();
         let chords = crate::check::chords_of(&path);
+        let every = crate::check::chords_beside(&path, half_bead);
+        // Both sorted by their first point.
+        let in_chords = every.iter().map(|c| chords.binary_search(c).ok()).collect();
         let (lo, hi) = crate::geometry::bounds(path.iter().map(|q| q.truncate()));
         let extent = (hi - lo).max_element().max(1e-9);
         let cell = half_bead.max(extent / Self::MAX_CELLS as f64).max(1e-9);
@@ -800,6 +835,8 @@ impl RimSupport {
         let mut grid = RimSupport {
             path,
             chords,
+            every,
+            in_chords,
             to_end,
             half_bead,
             gap: crate::check::just_laid_gap(limits),
@@ -815,13 +852,13 @@ impl RimSupport {
         };
         // Counted, then placed.
         let cells_of = |g: &RimSupport, id: usize| {
-            let (ia, ib) = g.chords[id];
+            let (ia, ib) = g.every[id];
             let (a, b) = (g.path[ia].truncate(), g.path[ib].truncate());
             let (c0, r0) = g.cell_of(a.min(b));
             let (c1, r1) = g.cell_of(a.max(b));
             (r0..=r1).flat_map(move |r| (c0..=c1).map(move |c| r * cols + c))
         };
-        for id in 0..grid.chords.len() {
+        for id in 0..grid.every.len() {
             for c in cells_of(&grid, id) {
                 grid.starts[c + 1] += 1;
             }
@@ -831,7 +868,7 @@ impl RimSupport {
         }
         let mut next = grid.starts.clone();
         let mut ids = vec![0; grid.starts[cols * rows]];
-        for id in 0..grid.chords.len() {
+        for id in 0..grid.every.len() {
             for c in cells_of(&grid, id) {
                 ids[next[c]] = id;
                 next[c] += 1;
@@ -860,20 +897,19 @@ impl RimSupport {
         for r in r0..=r1 {
             let (first, last) = (r * self.cols + c0, r * self.cols + c1);
             for &id in &self.ids[self.starts[first]..self.starts[last + 1]] {
-                let Some(ChordFoot { f, d, z: zq }) = crate::check::foot_under(
-                    &self.path,
-                    &self.chords,
-                    id,
-                    p,
-                    self.half_bead,
-                    self.half_bead,
-                ) else {
+                let (ia, ib) = self.every[id];
+                let (f_line, ChordFoot { f, d, z: zq }) =
+                    crate::check::chord_foot(self.path[ia], self.path[ib], p);
+                let beside = crate::check::within_window(f_line)
+                    || self.in_chords[id].is_some_and(|k| {
+                        crate::check::past_corner(&self.path, &self.chords, k, f_line, p)
+                    });
+                if d > self.half_bead || !beside {
                     continue;
-                };
+                }
                 if q.z - zq < self.same_layer {
                     continue;
                 }
-                let (ia, ib) = self.chords[id];
                 let behind =
                     along + self.to_end[ib] + (1.0 - f) * (self.to_end[ia] - self.to_end[ib]);
                 if crate::check::on_bead_just_laid(behind, d, q.z - zq, self.gap, self.min_layer) {
@@ -1337,11 +1373,63 @@ width = 90.8
         assert!((100..200).contains(&rim), "{rim} rim points");
     }
 
+    /// Found by random designs (seed 1337): a nine-sided foot lofted to an eight-sided top,
+    /// tilted by a horizontal control line. The self-check refused the rim's last point, 0.012
+    /// mm short: in the G-code, rounded to the micrometre, two segments of the last revolution
+    /// beside it fit one chord (on the path as computed, within 2.2 µm of a line: not), which
+    /// reached back 1.2 mm past its start to a point 0.1 mm higher. The rim now measures on
+    /// every chord the checker could cut, with the rounding's slack.
+    #[test]
+    fn the_rim_measures_the_chords_the_rounded_g_code_makes() {
+        let d = parse_design(
+            r#"version = 1
+[printer]
+layer_height = 1.0
+[shape]
+height = 140.3
+samples = 200
+base_layers = 1
+[shape.lower]
+type = "polygon"
+sides = 9
+radius = 38.02
+corner_radius = 4.56
+[shape.upper]
+type = "polygon"
+sides = 8
+radius = 38.49
+corner_radius = 2.63
+[[control.vertical]]
+points = [[0.0, 0.0], [0.15, 17.8], [0.41, -12.4], [1.0, 0.0]]
+[[control.vertical]]
+points = [[0.0, 0.0], [0.71, -2.6], [0.85, 1.1], [1.0, 0.0]]
+angle = 127.1
+width = 31.9
+[[control.horizontal]]
+at = 1.0
+reach = 0.25
+points = [[0.0, 0.0], [90.0, -0.9], [180.0, 0.0], [270.0, 4.0]]
+"#,
+        )
+        .unwrap();
+        let job = run(&d).unwrap();
+        let mut text = Vec::new();
+        crate::gcode::write_gcode(&d, &job, &mut text).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        // What `clayloft gcode` checks before it writes the file.
+        crate::export::verify_program(&d, &text).unwrap();
+        // The rim is still there: most of a revolution laid after the last layer start.
+        let rim = job.toolpath.points.len() - job.toolpath.layer_starts.last().unwrap();
+        assert!((100..200).contains(&rim), "{rim} rim points");
+    }
+
     /// The layer under a rim point as the checker finds it: a path below that runs out along
     /// y = 0 and back along y = 1 (a hairpin, rising 0.1 mm a point) has, under (5, 0.5), the
-    /// outward run's foot 0.5 mm high and the return's 1.5 mm high: the higher counts. Within
-    /// half a bead of nothing, nothing; the end of the path just laid, passed over until the rim
-    /// is a gap's length past it.
+    /// outward run's foot 0.5 mm high and the return's 1.5 mm high; and the checker may cut the
+    /// return into chords anywhere, one of them starting at x = 4, 1.6 mm high, 4 mm long,
+    /// which reaches back past (5, 1) by half its length: the highest counts. Within half a
+    /// bead of nothing, nothing; the end of the path just laid, passed over until the rim is a
+    /// gap's length past it.
     #[test]
     fn the_layer_under_a_rim_point_is_the_highest_spot_beside_it() {
         let point = |x: f64, y: f64, z: f64| PathPoint {
@@ -1354,9 +1442,9 @@ width = 90.8
         let back = (0..=10).map(|i| point(10.0 - i as f64, 1.0, 1.0 + 0.1 * i as f64));
         let path: Vec<PathPoint> = out.chain(back).collect();
         let limits = crate::check::Limits::from(&crate::design::Printer::default());
-        let under = RimSupport::new(&path, 1.5, &limits);
+        let under = RimSupport::new(&path, 1.5, &limits, [0.0, 0.0]);
         let top = under.top_under(DVec3::new(5.0, 0.5, 2.5), 100.0);
-        assert!((top.unwrap() - 1.5).abs() < 1e-12, "{top:?}");
+        assert!((top.unwrap() - 1.6).abs() < 1e-12, "{top:?}");
         assert_eq!(under.top_under(DVec3::new(5.0, 5.0, 2.5), 100.0), None);
         // Just past the path's end (0, 1, 2), 0.1 mm above it: the bead just laid is passed
         // over; the outward run's start, 2.1 mm under, is what lies below.

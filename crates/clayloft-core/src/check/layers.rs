@@ -527,26 +527,59 @@ fn chords_in(
     let mut count = 0;
     let mut i = first;
     while i < last {
-        let mut k = i + 1;
-        while k < last && k + 1 - i < MAX_POINTS_PER_CHORD {
-            let (a, b) = (v[i], v[k + 1]);
-            let ab = b - a;
-            let len2 = ab.length_squared();
-            let fits = len2 > 0.0
-                && (i + 1..=k).all(|m| {
-                    let f = ((v[m] - a).dot(ab) / len2).clamp(0.0, 1.0);
-                    (a + ab * f).distance_squared(v[m]) <= CHORD_TOLERANCE_MM * CHORD_TOLERANCE_MM
-                });
-            if !fits {
-                break;
-            }
-            k += 1;
-        }
+        let k = chord_end(v, i, last, f64::INFINITY);
         room[count].write((i, k));
         count += 1;
         i = k;
     }
     count
+}
+
+/// The end of the chord of path `v` that starts at point `i` (before `last`): the furthest
+/// point up to `last` (and [`MAX_POINTS_PER_CHORD`] points) with every point between within
+/// [`CHORD_TOLERANCE_MM`] of the straight line from `i` to it; or the first that lies `long` or
+/// further from `i` in XY.
+#[inline]
+fn chord_end(v: &[DVec3], i: usize, last: usize, long: f64) -> usize {
+    let mut k = i + 1;
+    while k < last
+        && k + 1 - i < MAX_POINTS_PER_CHORD
+        && (long == f64::INFINITY || v[k].truncate().distance(v[i].truncate()) < long)
+    {
+        let (a, b) = (v[i], v[k + 1]);
+        let ab = b - a;
+        let len2 = ab.length_squared();
+        let fits = len2 > 0.0
+            && (i + 1..=k).all(|m| {
+                let f = ((v[m] - a).dot(ab) / len2).clamp(0.0, 1.0);
+                (a + ab * f).distance_squared(v[m]) <= CHORD_TOLERANCE_MM * CHORD_TOLERANCE_MM
+            });
+        if !fits {
+            break;
+        }
+        k += 1;
+    }
+    k
+}
+
+/// The chords the checker could cut from path `v` (a stretch of a longer path), as far as a
+/// point within `reach` of one of their ends can tell: the checker cuts the whole path into
+/// chords from its start, so those of a stretch start wherever the ones before them ended.
+/// From each point, the chord forward as [`chords_of`] would make it were one to start there,
+/// and backward to each point the same way round; each stopped once it is `2 · reach` long in XY
+/// (a point within reach of such a chord's end lies within half its length of it, in its
+/// window ([`within_window`]), however much longer it is).
+pub(crate) fn chords_beside(v: &[DVec3], reach: f64) -> Vec<(usize, usize)> {
+    let last = v.len().saturating_sub(1);
+    let long = 2.0 * reach;
+    let mut chords: Vec<(usize, usize)> = (0..last)
+        .map(|i| (i, chord_end(v, i, last, long)))
+        .collect();
+    let back: Vec<DVec3> = v.iter().rev().copied().collect();
+    chords.extend((0..last).map(|i| (last - chord_end(&back, i, last, long), last - i)));
+    chords.sort_unstable();
+    chords.dedup();
+    chords
 }
 
 /// Measures the layers of an extruding path `v` (see the module documentation of
@@ -1210,7 +1243,7 @@ pub(crate) fn past_corner(
 /// along its own direction is beside `p`, not under it) unless `p` is within `half_bead` and
 /// outside the tip of a sharp corner there ([`past_corner`]).
 #[inline]
-pub(crate) fn foot_under(
+fn foot_under(
     v: &[DVec3],
     chords: &[(usize, usize)],
     id: usize,
@@ -1219,7 +1252,26 @@ pub(crate) fn foot_under(
     half_bead: f64,
 ) -> Option<ChordFoot> {
     let (ia, ib) = chords[id];
-    let (a, b) = (v[ia], v[ib]);
+    let (f_line, foot) = chord_foot(v[ia], v[ib], p);
+    if foot.d > radius
+        || !(within_window(f_line) || foot.d <= half_bead && past_corner(v, chords, id, f_line, p))
+    {
+        return None;
+    }
+    Some(foot)
+}
+
+/// Whether a point at `f_line` along a chord's line lies beside the chord rather than ahead
+/// of it or behind it: within half the chord's length past either end.
+#[inline]
+pub(crate) fn within_window(f_line: f64) -> bool {
+    (-0.5..=1.5).contains(&f_line)
+}
+
+/// The foot of the perpendicular from `p` on the chord `a`–`b` (in XY): its fraction along
+/// the chord's line, and the foot clamped to the chord ([`ChordFoot`]).
+#[inline]
+pub(crate) fn chord_foot(a: DVec3, b: DVec3, p: DVec2) -> (f64, ChordFoot) {
     let (a2, b2) = (a.truncate(), b.truncate());
     let ab = b2 - a2;
     let len2 = ab.length_squared();
@@ -1230,18 +1282,12 @@ pub(crate) fn foot_under(
     };
     // `point_segment_distance` with the fraction along the line above.
     let f = f_line.clamp(0.0, 1.0);
-    let d = p.distance(a2 + ab * f);
-    if d > radius
-        || !((-0.5..=1.5).contains(&f_line)
-            || d <= half_bead && past_corner(v, chords, id, f_line, p))
-    {
-        return None;
-    }
-    Some(ChordFoot {
+    let foot = ChordFoot {
         f,
-        d,
+        d: p.distance(a2 + ab * f),
         z: a.z + (b.z - a.z) * f,
-    })
+    };
+    (f_line, foot)
 }
 
 /// The foot of the perpendicular on a chord under a point ([`foot_under`]).
@@ -1853,6 +1899,27 @@ mod tests {
             measure_layers_in(&v, &lines, &limits, &mut whole, Search::WholeBox, false, None);
             prop_assert_eq!(&near, &whole);
         }
+    }
+
+    /// Three points in a line but the middle, 3 µm off it (more than the chords' tolerance):
+    /// each point starts a chord and ends one. In a line, the first point's chord takes in the
+    /// next, which still starts one of its own, and the last's backward chord reaches the first;
+    /// a chord stops once it is twice the reach long.
+    #[test]
+    fn chords_beside_start_and_end_at_every_point() {
+        let v = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.003, 0.0),
+            DVec3::new(2.0, 0.0, 0.0),
+        ];
+        assert_eq!(chords_of(&v), vec![(0, 1), (1, 2)]);
+        assert_eq!(chords_beside(&v, 1.5), vec![(0, 1), (1, 2)]);
+        let line: Vec<DVec3> = (0..5).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        assert_eq!(chords_of(&line), vec![(0, 4)]);
+        assert_eq!(
+            chords_beside(&line, 1.5),
+            vec![(0, 1), (0, 2), (0, 3), (1, 4), (2, 4), (3, 4)]
+        );
     }
 
     /// A flat spiral base from the centre out, then a wall that climbs, steps back down to

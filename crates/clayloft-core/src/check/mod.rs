@@ -21,8 +21,8 @@
 mod crossings;
 mod layers;
 pub(crate) use layers::{
-    ChordFoot, chords_of, foot_under, just_laid_gap, on_bead_just_laid, same_layer_tolerance,
-    thinnest_layer_accepted,
+    ChordFoot, chord_foot, chords_beside, chords_of, just_laid_gap, on_bead_just_laid, past_corner,
+    same_layer_tolerance, thinnest_layer_accepted, within_window,
 };
 mod limits;
 mod moves;
